@@ -1,0 +1,15 @@
+# Source me: the environment every ardsim command runs in (Debian's ROS 1 under /usr, the workspace's devel space).
+ARDSIM_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+export PATH=/usr/bin:$PATH   # a pyenv python3 earlier on PATH hides Debian's python3 and its ROS modules
+if [ -f "$ARDSIM_ROOT/devel/setup.bash" ]; then
+  # shellcheck disable=SC1091
+  . "$ARDSIM_ROOT/devel/setup.bash"
+else
+  for f in /etc/catkin/profile.d/*.sh; do . "$f"; done
+fi
+export ROS_HOME="${ROS_HOME:-$ARDSIM_ROOT/.ros}"
+export ROS_MASTER_URI="${ROS_MASTER_URI:-http://127.0.0.1:11311}" ROS_IP=127.0.0.1
+export ROSCONSOLE_STDOUT_LINE_BUFFERED=1
+# Mesa, Qt and rviz write caches under $HOME: keep them inside the workspace.
+export XDG_CACHE_HOME="${XDG_CACHE_HOME:-$ARDSIM_ROOT/.home/cache}"
+mkdir -p "$ROS_HOME" "$XDG_CACHE_HOME"
