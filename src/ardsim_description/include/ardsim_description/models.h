@@ -1,0 +1,30 @@
+// Procedural, parametric meshes of the targets and the chaser, in their body frames (origin at the centre of mass,
+// see frames.h). Dimensions: shared reference iss_geometry.md; the sources say which values are sourced or estimated.
+#pragma once
+
+#include <array>
+
+#include "ardsim_description/frames.h"
+#include "ardsim_description/mesh.h"
+
+namespace ardsim_description {
+
+struct IssOptions {
+  double sarj_port_deg = 0.0;           // port solar alpha rotary joint: outboard truss about body y
+  double sarj_starboard_deg = 0.0;      // starboard solar alpha rotary joint
+  std::array<double, 8> beta_deg{};     // beta gimbals of the eight wings (about each wing's mast)
+  bool centreline_docking_target = true;  // the standoff cross behind the IDA-2 hatch
+};
+TriangleMesh buildIss(const IssOptions& options = {});
+
+struct HubbleOptions {
+  double solar_array_deg = 0.0;  // rotation of both arrays about their masts
+};
+TriangleMesh buildHubble(const HubbleOptions& options = {});
+
+TriangleMesh buildChaser();
+
+// The target with default options.
+TriangleMesh buildTarget(TargetKind kind);
+
+}  // namespace ardsim_description
