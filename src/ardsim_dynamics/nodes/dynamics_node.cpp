@@ -19,6 +19,7 @@
 
 #include "ardsim_dynamics/simulation.h"
 #include "conversions.h"
+#include "log_throttle.h"
 
 namespace ardsim_dynamics {
 namespace {
@@ -32,6 +33,9 @@ struct DynamicsNodeOptions {
   int wait_for_subscribers = 0;     // before the first step, wait (up to startup_timeout_s) for this many
                                     // subscribers of truth/chaser/odom
   double duration_s = 0.0;          // run length; 0 = the scenario's simulation.duration_s
+  // false: after the last step keep the final state latched until shut down, so that slower subscribers drain
+  // their queues (a free run outpaces them).
+  bool exit_at_end = true;
 };
 
 void requireRange(const std::string& name, double value, double min, double max) {
@@ -53,6 +57,7 @@ DynamicsNodeOptions loadOptions(const ros::NodeHandle& pnh) {
   pnh.param("free_run", o.free_run, o.free_run);
   pnh.param("wait_for_subscribers", o.wait_for_subscribers, o.wait_for_subscribers);
   pnh.param("duration_s", o.duration_s, o.duration_s);
+  pnh.param("exit_at_end", o.exit_at_end, o.exit_at_end);
   requireRange("real_time_factor", o.real_time_factor, 0.0, 1e6);
   requireRange("command_timeout_s", o.command_timeout_s, 1e-3, 3600.0);
   requireRange("startup_timeout_s", o.startup_timeout_s, 1e-3, 3600.0);
@@ -65,13 +70,16 @@ class DynamicsNode {
  public:
   DynamicsNode(ros::NodeHandle& nh, const DynamicsNodeOptions& options, Simulation& sim)
       : options_(options), sim_(sim) {
-    // Latched: a node that connects late (at start-up, or respawned) still gets the current step.
-    clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10, true);
-    target_pub_ = nh.advertise<nav_msgs::Odometry>("truth/target/odom", 10, true);
-    chaser_pub_ = nh.advertise<nav_msgs::Odometry>("truth/chaser/odom", 10, true);
-    relative_pub_ = nh.advertise<nav_msgs::Odometry>("truth/relative", 10, true);
-    applied_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("dynamics/applied_wrench", 10);
-    tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
+    // Latched: a node that connects late (at start-up, or respawned) still gets the current step. In lockstep
+    // at most one step is in flight; a free run publishes as fast as it integrates, so its queues must hold a
+    // whole burst.
+    const std::uint32_t queue = options_.free_run ? 100000 : 100;
+    clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", queue, true);
+    target_pub_ = nh.advertise<nav_msgs::Odometry>("truth/target/odom", queue, true);
+    chaser_pub_ = nh.advertise<nav_msgs::Odometry>("truth/chaser/odom", queue, true);
+    relative_pub_ = nh.advertise<nav_msgs::Odometry>("truth/relative", queue, true);
+    applied_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("dynamics/applied_wrench", queue);
+    tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", queue);
     if (!options_.free_run) {
       ros::SubscribeOptions so = ros::SubscribeOptions::create<geometry_msgs::WrenchStamped>(
           "guidance/command", 10,
@@ -110,6 +118,7 @@ class DynamicsNode {
     const double wall_s = (ros::WallTime::now() - wall_start).toSec();
     ROS_INFO("dynamics: reached t = %.1f s in %.1f s wall (real-time factor %.1f), %d command timeouts",
              sim_.time(), wall_s, wall_s > 0.0 ? sim_.time() / wall_s : 0.0, timeouts_);
+    if (!options_.exit_at_end) ros::waitForShutdown();
     return 0;
   }
 
@@ -169,7 +178,7 @@ class DynamicsNode {
       }
       if (ros::WallTime::now() > deadline) {
         ++timeouts_;
-        ROS_WARN_THROTTLE(
+        ARDSIM_WARN_THROTTLE(
             5.0,
             "dynamics: no guidance/command for t = %.3f s within %.2f s wall: applying zero wrench "
             "(%d timeouts so far)",
@@ -182,18 +191,18 @@ class DynamicsNode {
 
   void onCommand(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
     if (msg->header.stamp != expected_stamp_) {
-      ROS_WARN_THROTTLE(5.0, "dynamics: ignoring guidance/command stamped %.3f s while waiting for %.3f s",
-                        msg->header.stamp.toSec(), expected_stamp_.toSec());
+      ARDSIM_WARN_THROTTLE(5.0, "dynamics: ignoring guidance/command stamped %.3f s while waiting for %.3f s",
+                           msg->header.stamp.toSec(), expected_stamp_.toSec());
       return;
     }
     BodyWrench command;
     if (!msg->header.frame_id.empty() && msg->header.frame_id != "chaser") {
-      ROS_WARN_THROTTLE(5.0,
-                        "dynamics: guidance/command in frame '%s', expected 'chaser': applying zero wrench",
-                        msg->header.frame_id.c_str());
+      ARDSIM_WARN_THROTTLE(
+          5.0, "dynamics: guidance/command in frame '%s', expected 'chaser': applying zero wrench",
+          msg->header.frame_id.c_str());
     } else if (!fromWrench(msg->wrench, command)) {
-      ROS_WARN_THROTTLE(5.0, "dynamics: non-finite guidance/command at t = %.3f s: applying zero wrench",
-                        msg->header.stamp.toSec());
+      ARDSIM_WARN_THROTTLE(5.0, "dynamics: non-finite guidance/command at t = %.3f s: applying zero wrench",
+                           msg->header.stamp.toSec());
     }
     command_ = command;
     have_command_ = true;

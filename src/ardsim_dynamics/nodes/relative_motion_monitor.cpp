@@ -1,6 +1,8 @@
 // relative_motion_monitor: prints the chaser's motion in the target's LVLH from the truth topics, next to the
 // Clohessy-Wiltshire prediction from the first state received (the free-drift demo's table).
-// Parameter ~print_every_s (default 300): simulation time between rows.
+// Parameters: ~print_every_s (default 300): simulation time between rows; ~end_s (default 0 = never): print
+// the row at this time and exit, so that a launch whose monitor is `required` ends once the table is
+// complete.
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -19,6 +21,8 @@ using ardsim_dynamics::CartesianState;
 
 struct Monitor {
   double print_every_s = 300.0;
+  double end_s = 0.0;
+  bool done = false;
   std::optional<CartesianState> initial_relative;
   double t0 = 0.0, mean_motion = 0.0, next_print = 0.0, worst_difference = 0.0;
 
@@ -44,12 +48,19 @@ struct Monitor {
     const CartesianState cw = ardsim_dynamics::cwPropagate(*initial_relative, mean_motion, t - t0);
     const double difference = (rel.position_m - cw.position_m).norm();
     worst_difference = std::max(worst_difference, difference);
-    if (t + 1e-9 >= next_print) {
+    const bool last = end_s > 0.0 && t + 1e-9 >= end_s;
+    if (t + 1e-9 >= next_print || last) {
       std::printf("%8.0f | %9.2f %9.2f %9.2f | %9.2f %9.2f %9.2f | %9.3f\n", t, rel.position_m.x(),
                   rel.position_m.y(), rel.position_m.z(), cw.position_m.x(), cw.position_m.y(),
                   cw.position_m.z(), difference);
       std::fflush(stdout);
       next_print += print_every_s;
+    }
+    if (last && !done) {
+      done = true;
+      std::printf("largest truth - CW difference over the run: %.3f m\n", worst_difference);
+      std::fflush(stdout);
+      ros::shutdown();
     }
   }
 };
@@ -61,8 +72,13 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   Monitor monitor;
   pnh.param("print_every_s", monitor.print_every_s, monitor.print_every_s);
-  if (!(monitor.print_every_s > 0.0)) {
-    ROS_FATAL("parameter ~print_every_s = %g is outside the allowed range (0, inf)", monitor.print_every_s);
+  pnh.param("end_s", monitor.end_s, monitor.end_s);
+  if (!(monitor.print_every_s > 0.0 && monitor.print_every_s < 1e7)) {
+    ROS_FATAL("parameter ~print_every_s = %g is outside the allowed range (0, 1e7)", monitor.print_every_s);
+    return 1;
+  }
+  if (!(monitor.end_s >= 0.0 && monitor.end_s < 1e7)) {
+    ROS_FATAL("parameter ~end_s = %g is outside the allowed range [0, 1e7)", monitor.end_s);
     return 1;
   }
   // Deep queues: in a free run the dynamics publishes faster than this prints.
@@ -72,7 +88,5 @@ int main(int argc, char** argv) {
                                                                                  1000);
   sync.registerCallback(&Monitor::onTruth, &monitor);
   ros::spin();
-  if (monitor.initial_relative)
-    std::printf("largest truth - CW difference over the run: %.3f m\n", monitor.worst_difference);
   return 0;
 }
