@@ -11,12 +11,6 @@ Environment makeEnvironment(const Scenario& s) {
   return Environment(std::move(field), s.environment);
 }
 
-// Docking attitude: chaser port x anti-parallel to target port x (a half turn about the port z axis).
-const Eigen::Matrix3d& R_targetport_chaserport_docked() {
-  static const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return R;
-}
-
 }  // namespace
 
 Eigen::Isometry3d poseOf(const VehicleState& state) {
@@ -48,7 +42,7 @@ InitialStates initialStates(const Scenario& s) {
   Eigen::Vector3d v_chaser;
   if (s.chaser_initial.frame == RelativeFrame::kTargetPort) {
     Eigen::Isometry3d T_tp_cp = Eigen::Isometry3d::Identity();
-    T_tp_cp.linear() = R_targetport_chaserport_docked() * R_offset;
+    T_tp_cp.linear() = ardsim_description::T_port_port_docked().linear() * R_offset;
     T_tp_cp.translation() = s.chaser_initial.position_m;
     T_eci_chaser = T_eci_target * T_target_port_ * T_tp_cp * T_chaser_port().inverse();
     const Eigen::Matrix3d R_eci_tp = (T_eci_target * T_target_port_).linear();
@@ -60,7 +54,7 @@ InitialStates initialStates(const Scenario& s) {
         target_orbit, CartesianState{s.chaser_initial.position_m, s.chaser_initial.velocity_mps});
     T_eci_chaser = Eigen::Isometry3d::Identity();
     // Docking attitude relative to the target's attitude, then the offset.
-    const Eigen::Matrix3d R_target_chaser = T_target_port_.linear() * R_targetport_chaserport_docked() *
+    const Eigen::Matrix3d R_target_chaser = T_target_port_.linear() * ardsim_description::T_port_port_docked().linear() *
                                             R_offset * T_chaser_port().linear().transpose();
     T_eci_chaser.linear() = T_eci_target.linear() * R_target_chaser;
     T_eci_chaser.translation() = chaser.position_m;
