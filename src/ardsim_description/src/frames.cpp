@@ -10,14 +10,16 @@ TargetKind parseTargetKind(const std::string& name) {
   throw std::invalid_argument("target '" + name + "' is not one of: iss, hubble");
 }
 
-std::string targetKindName(TargetKind kind) { return kind == TargetKind::kIss ? "iss" : "hubble"; }
+std::string targetKindName(TargetKind kind) {
+  return kind == TargetKind::kIss ? "iss" : "hubble";
+}
 
 Eigen::Isometry3d T_target_port(TargetKind kind) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (kind == TargetKind::kIss) {
-    // IDA-2 on PMA-2 on Harmony: docking plane at X ~ +14.5 m, Z ~ +4..+5 m below the truss, facing +X (+V-bar)
-    // [iss_geometry.md: derived from module lengths; the Z offset is an estimate]. Body origin taken at the CoM,
-    // assumed at the S0 centre (estimate).
+    // IDA-2 on PMA-2 on Harmony: docking plane at X ~ +14.5 m, Z ~ +4..+5 m below the truss, facing +X
+    // (+V-bar) [iss_geometry.md: derived from module lengths; the Z offset is an estimate]. Body origin taken
+    // at the CoM, assumed at the S0 centre (estimate).
     T.translation() = Eigen::Vector3d(14.5, 0.0, 4.5);
   } else {
     // Hubble soft-capture mechanism on the aft bulkhead, 13.2 m long telescope with its CoM near mid-length
@@ -35,9 +37,13 @@ Eigen::Isometry3d T_chaser_port() {
   return T;
 }
 
+Eigen::Isometry3d T_port_port_docked() {
+  return Eigen::Isometry3d(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+}
+
 Eigen::Isometry3d T_chaser_lidar() {
-  // On the port axis, 1.0 m behind the port plane, looking out of the port (estimate): centred so that the target
-  // port stays in the 20 deg field of view down to contact.
+  // On the port axis, 1.0 m behind the port plane, looking out of the port (estimate): centred so that the
+  // target port stays in the 20 deg field of view down to contact.
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.translation() = Eigen::Vector3d(2.0, 0.0, 0.0);
   // Columns: lidar x (image right) = chaser +y (starboard), lidar y (image down) = chaser +z (nadir side),

@@ -19,7 +19,15 @@ TEST(Frames, IssPortFacesVelocityDirection) {
   EXPECT_GT(T.translation().x(), 10.0);
 }
 
+TEST(Frames, DockedPortsFaceEachOtherAndShareZ) {
+  const Eigen::Matrix3d R = T_port_port_docked().linear();
+  EXPECT_NEAR((R * Eigen::Vector3d::UnitX()).x(), -1.0, 1e-12);
+  EXPECT_NEAR((R * Eigen::Vector3d::UnitZ()).z(), 1.0, 1e-12);
+  EXPECT_NEAR(T_port_port_docked().translation().norm(), 0.0, 1e-12);
+}
+
 TEST(Frames, ParseTargetKindRejectsUnknownNames) {
   EXPECT_EQ(parseTargetKind("hubble"), TargetKind::kHubble);
+  EXPECT_EQ(targetKindName(parseTargetKind("iss")), "iss");
   EXPECT_THROW(parseTargetKind("mir"), std::invalid_argument);
 }
