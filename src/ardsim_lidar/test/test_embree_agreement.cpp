@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "ardsim_description/models.h"
+#include "ardsim_lidar/docking_views.h"
 #include "ardsim_lidar/egl_renderer.h"
 #include "ardsim_lidar/embree_ray_caster.h"
 #include "test_shapes.h"
@@ -52,6 +54,28 @@ TEST(EmbreeAgreement, BoxInFrontOfPlateGivesTheSameRangeImage) {
   int both_hit = 0;
   EXPECT_LT(disagreement(rasterised, ray_cast, 1e-3, &both_hit), 0.002);
   EXPECT_GT(both_hit, 20000);
+}
+
+// The ISS from the docking axis, as in bench_lidar: the two range images agree pixel by pixel.
+TEST(EmbreeAgreement, IssFromTheDockingAxisGivesTheSameRangeImage) {
+  const ardsim_description::TriangleMesh mesh = ardsim_description::buildIss();
+  const SensorOptions sensor;
+  EglRenderer renderer(sensor);
+  renderer.setMesh(mesh);
+  const EmbreeRayCaster caster(sensor, mesh);
+  for (double range_m : {100.0, 30.0, 10.0, 3.0}) {
+    const Eigen::Isometry3d T = lidarOnDockingAxis(ardsim_description::TargetKind::kIss, range_m);
+    RenderedFrame rasterised;
+    RenderedFrame ray_cast;
+    renderer.render(T, &rasterised);
+    caster.cast(T, &ray_cast);
+    int both_hit = 0;
+    const double fraction = disagreement(rasterised, ray_cast, 1e-3, &both_hit);
+    EXPECT_LT(fraction, 0.005) << "at " << range_m << " m";
+    EXPECT_GT(both_hit, 10000) << "at " << range_m << " m";
+    std::printf("ISS at %5.1f m: %d pixels hit by both, %.4f %% disagree\n", range_m, both_hit,
+                100.0 * fraction);
+  }
 }
 
 }  // namespace
