@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <tbb/parallel_for.h>
+
 namespace ardsim_lidar {
 
 namespace {
@@ -19,6 +21,10 @@ void require(bool ok, const std::string& name, double value, const std::string& 
   message << "parameter noise/" << name << " = " << value << " is out of range: allowed " << allowed;
   throw std::invalid_argument(message.str());
 }
+
+// Rows are processed in fixed blocks, each with its own random stream, so blocks can run in parallel and the
+// frame does not depend on the number of threads.
+constexpr int kRowsPerBlock = 16;
 
 bool inClosed(double value, double low, double high) {
   return std::isfinite(value) && value >= low && value <= high;
@@ -97,7 +103,8 @@ NoiseModel::NoiseModel(const SensorOptions& sensor, const NoiseOptions& options,
 
 double NoiseModel::strength(double reflectivity, double cos_incidence, bool retro_reflector,
                             double range_m) const {
-  const double spreading = std::pow(options_.detection_range_m / range_m, 2);
+  const double ratio = options_.detection_range_m / range_m;
+  const double spreading = ratio * ratio;
   if (retro_reflector && options_.retro_reflectors && cos_incidence >= cos_retro_acceptance_)
     return options_.retro_gain * reflectivity * spreading;
   return reflectivity * cos_incidence * spreading;
@@ -149,58 +156,71 @@ void NoiseModel::apply(const RenderedFrame& rendered,
     return;
   }
 
-  std::seed_seq sequence{low32(seed_), high32(seed_), low32(frame_index), high32(frame_index), 1u};
+  const int block_count = (height + kRowsPerBlock - 1) / kRowsPerBlock;
+  std::vector<std::vector<int>> saturated_retro_pixels(block_count);
+  tbb::parallel_for(0, block_count, [&](int block) {
+    // Stream 0 is the frame's sequential stream (below); block b uses stream b + 1.
+    std::seed_seq sequence{low32(seed_), high32(seed_), low32(frame_index), high32(frame_index),
+                           static_cast<std::uint32_t>(block + 1)};
+    std::mt19937_64 rng(sequence);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const int last_row = std::min(height, (block + 1) * kRowsPerBlock);
+    for (int v = block * kRowsPerBlock; v < last_row; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const int i = v * width + u;
+        const SurfaceSample& sample = rendered.pixels[i];
+        // Surfaces closer than min_range are in the detector's blind zone: they hide what is behind but do
+        // not return.
+        if (!(sample.range_m >= min_range && sample.range_m <= max_range)) continue;
+        const ardsim_description::Material& material = materialOf(sample);
+        const bool retro = options_.retro_reflectors && material.retro_reflector &&
+                           sample.cos_incidence >= cos_retro_acceptance_;
+        if (options_.incidence_cutoff && !retro && sample.cos_incidence < cos_max_incidence_) continue;
+        const double s =
+            strength(material.reflectivity, sample.cos_incidence, material.retro_reflector, sample.range_m);
+        // Beyond s = 40 the probability is 1 to double precision: no draw needed (most close-range pixels).
+        if (options_.return_probability && s < 40.0 && uniform(rng) >= returnProbability(s)) continue;
+
+        double range = sample.range_m;
+        if (options_.mixed_pixels) {
+          // The neighbour across the largest depth jump: the pixel's footprint straddles both surfaces.
+          double jump = 0.0;
+          const int neighbours[4][2] = {{u - 1, v}, {u + 1, v}, {u, v - 1}, {u, v + 1}};
+          for (const auto& n : neighbours) {
+            if (n[0] < 0 || n[0] >= width || n[1] < 0 || n[1] >= height) continue;
+            const SurfaceSample& other = rendered.pixels[n[1] * width + n[0]];
+            if (other.range_m <= 0.0f) continue;
+            const double difference = other.range_m - sample.range_m;
+            if (std::abs(difference) > std::abs(jump)) jump = difference;
+          }
+          if (std::abs(jump) > options_.mixed_pixel_min_jump_m &&
+              uniform(rng) < options_.mixed_pixel_probability)
+            range += uniform(rng) * jump;
+        }
+        if (options_.range_noise) range += rangeSigma(s) * normal(rng);
+        const double return_intensity = intensity(s);
+        const bool saturated = s >= saturation_strength_;
+        if (options_.saturation && saturated) range += options_.saturation_range_bias_m;
+        if (!(range >= min_range && range <= max_range)) continue;
+        frame->range_m[i] = static_cast<float>(range);
+        frame->intensity[i] = static_cast<float>(return_intensity);
+        if (options_.blooming && retro && saturated) saturated_retro_pixels[block].push_back(i);
+      }
+    }
+  });
+
+  std::seed_seq sequence{low32(seed_), high32(seed_), low32(frame_index), high32(frame_index), 0u};
   std::mt19937_64 rng(sequence);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  std::vector<int> saturated_retro_pixels;
-
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
-      const int i = v * width + u;
-      const SurfaceSample& sample = rendered.pixels[i];
-      // Surfaces closer than min_range are in the detector's blind zone: they hide what is behind but do not
-      // return.
-      if (!(sample.range_m >= min_range && sample.range_m <= max_range)) continue;
-      const ardsim_description::Material& material = materialOf(sample);
-      const bool retro = options_.retro_reflectors && material.retro_reflector &&
-                         sample.cos_incidence >= cos_retro_acceptance_;
-      if (options_.incidence_cutoff && !retro && sample.cos_incidence < cos_max_incidence_) continue;
-      const double s =
-          strength(material.reflectivity, sample.cos_incidence, material.retro_reflector, sample.range_m);
-      if (options_.return_probability && uniform(rng) >= returnProbability(s)) continue;
-
-      double range = sample.range_m;
-      if (options_.mixed_pixels) {
-        // The neighbour across the largest depth jump: the pixel's footprint straddles both surfaces.
-        double jump = 0.0;
-        const int neighbours[4][2] = {{u - 1, v}, {u + 1, v}, {u, v - 1}, {u, v + 1}};
-        for (const auto& n : neighbours) {
-          if (n[0] < 0 || n[0] >= width || n[1] < 0 || n[1] >= height) continue;
-          const SurfaceSample& other = rendered.pixels[n[1] * width + n[0]];
-          if (other.range_m <= 0.0f) continue;
-          const double difference = other.range_m - sample.range_m;
-          if (std::abs(difference) > std::abs(jump)) jump = difference;
-        }
-        if (std::abs(jump) > options_.mixed_pixel_min_jump_m &&
-            uniform(rng) < options_.mixed_pixel_probability)
-          range += uniform(rng) * jump;
-      }
-      if (options_.range_noise) range += rangeSigma(s) * normal(rng);
-      const double return_intensity = intensity(s);
-      const bool saturated = s >= saturation_strength_;
-      if (options_.saturation && saturated) range += options_.saturation_range_bias_m;
-      if (!(range >= min_range && range <= max_range)) continue;
-      frame->range_m[i] = static_cast<float>(range);
-      frame->intensity[i] = static_cast<float>(return_intensity);
-      if (options_.blooming && retro && saturated) saturated_retro_pixels.push_back(i);
-    }
-  }
 
   // Blooming: light from a saturated retro-reflector spills into neighbours that have a weaker (or no)
   // return.
   const int radius = options_.bloom_radius_px;
-  for (const int source : saturated_retro_pixels) {
+  std::vector<int> bloom_sources;  // in block order, so the draws below do not depend on scheduling
+  for (const auto& block : saturated_retro_pixels)
+    bloom_sources.insert(bloom_sources.end(), block.begin(), block.end());
+  for (const int source : bloom_sources) {
     const int su = source % width;
     const int sv = source / width;
     for (int dv = -radius; dv <= radius; ++dv) {
