@@ -11,7 +11,6 @@
 #include "ardsim_lidar/lidar_simulator.h"
 
 namespace ardsim_lidar {
-namespace {
 
 struct Fixture {
   ardsim_description::TriangleMesh mesh = ardsim_description::buildIss();
@@ -33,6 +32,8 @@ Fixture& fixture() {
   static Fixture instance;
   return instance;
 }
+
+namespace {
 
 void BM_RenderIss_Ardsim(benchmark::State& state) {
   Fixture& f = fixture();
@@ -90,4 +91,12 @@ BENCHMARK(BM_RenderIss_Embree)
 }  // namespace
 }  // namespace ardsim_lidar
 
-BENCHMARK_MAIN();
+// The fixture is built before the run so that its context (GL_RENDERER, mesh size) heads the report.
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  ardsim_lidar::fixture();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
