@@ -1,0 +1,67 @@
+// Off-screen OpenGL depth renderer of a triangle mesh seen by the flash LIDAR. EGL without any window system:
+// the EGL device platform on a hardware GPU (NVIDIA's EGL, found with eglQueryDevicesEXT) where one exists,
+// otherwise Mesa's surfaceless platform (llvmpipe on machines without a GPU). ROS-free.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "ardsim_description/mesh.h"
+#include "ardsim_lidar/rendered_frame.h"
+#include "ardsim_lidar/sensor.h"
+
+namespace ardsim_lidar {
+
+enum class EglPlatform {
+  kAuto,         // a hardware EGL device if there is one, else Mesa surfaceless
+  kDevice,       // EGL_EXT_platform_device only (fails without a hardware device)
+  kSurfaceless,  // EGL_MESA_platform_surfaceless only
+};
+// "auto", "device" or "surfaceless"; throws std::invalid_argument otherwise.
+EglPlatform parseEglPlatform(const std::string& name);
+
+struct RendererOptions {
+  EglPlatform platform = EglPlatform::kAuto;
+  // Triangles are grouped into spatially compact chunks; chunks whose bounding sphere lies outside the view
+  // frustum are not drawn (llvmpipe's cost grows with the triangles it is given).
+  int triangles_per_chunk = 1024;
+};
+
+// Renders into a framebuffer object: a GL_DEPTH_COMPONENT32F depth buffer with reversed Z (uniform relative
+// depth precision from the near plane to 5 km) for visibility, and an RGBA32F colour target holding, per
+// pixel, the range along the pixel's ray, the cosine of incidence and the material index (SurfaceSample).
+// Range comes from the interpolated lidar-frame position, so it is exact at the pixel centre (no depth-buffer
+// quantisation).
+//
+// Thread-safe: each call makes the context current on the calling thread and releases it again, so a
+// nodelet's callbacks may run on any thread.
+class EglRenderer {
+ public:
+  // Throws std::runtime_error when no EGL display, OpenGL 3.3 core context or required extension is
+  // available.
+  EglRenderer(const SensorOptions& sensor, const RendererOptions& options = {});
+  ~EglRenderer();
+  EglRenderer(const EglRenderer&) = delete;
+  EglRenderer& operator=(const EglRenderer&) = delete;
+
+  // Uploads the mesh once (vertex and index buffers, per-triangle normal and material); replaces any earlier
+  // mesh.
+  void setMesh(const ardsim_description::TriangleMesh& mesh);
+
+  // Renders the mesh with T_lidar_target (target coordinates -> lidar_optical coordinates) and reads back the
+  // frame. Without a mesh every pixel has no surface.
+  void render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame);
+
+  const std::string& glRenderer() const;        // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  const std::string& eglPlatform() const;       // "device" or "surfaceless"
+  std::size_t trianglesDrawnLastFrame() const;  // after chunk culling, before back-face culling
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ardsim_lidar

@@ -1,0 +1,26 @@
+// What the geometry stage (EGL renderer or Embree ray caster) hands to the noise model: per pixel, the
+// nearest surface along the pixel's ray. ROS-free.
+#pragma once
+
+#include <vector>
+
+namespace ardsim_lidar {
+
+// One pixel as read back from the renderer's RGBA32F colour target (so the readback is a single memcpy).
+struct SurfaceSample {
+  float range_m = 0.0f;        // along the pixel's unit ray; 0 = no surface within the render volume
+  float cos_incidence = 0.0f;  // |cos| of the angle between the ray and the triangle's normal
+  float material = -1.0f;      // index into TriangleMesh::materials; < 0 where there is no surface
+  float unused = 0.0f;
+};
+static_assert(sizeof(SurfaceSample) == 4 * sizeof(float), "SurfaceSample must match the RGBA32F texel");
+
+struct RenderedFrame {
+  int width = 0;
+  int height = 0;
+  std::vector<SurfaceSample> pixels;  // row-major, row 0 at the top of the image (y down)
+
+  bool hasSurface(int index) const { return pixels[index].range_m > 0.0f; }
+};
+
+}  // namespace ardsim_lidar

@@ -1,0 +1,495 @@
+#include "ardsim_lidar/egl_renderer.h"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/glcorearb.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
+namespace ardsim_lidar {
+
+namespace {
+
+constexpr const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 position_target;
+uniform mat4 T_lidar_target;
+uniform mat4 projection;
+out vec3 position_lidar;
+void main() {
+  vec4 p = T_lidar_target * vec4(position_target, 1.0);
+  position_lidar = p.xyz;
+  gl_Position = projection * p;
+}
+)";
+
+// gl_PrimitiveID restarts at 0 with each draw call, so first_triangle says where the draw starts in the
+// per-triangle buffer (normal in the target frame, material index in w).
+constexpr const char* kFragmentShader = R"(#version 330 core
+in vec3 position_lidar;
+uniform samplerBuffer triangle_normal_material;
+uniform mat3 R_lidar_target;
+uniform int first_triangle;
+layout(location = 0) out vec4 range_cos_material;
+void main() {
+  vec4 normal_material = texelFetch(triangle_normal_material, first_triangle + gl_PrimitiveID);
+  float range = length(position_lidar);
+  vec3 normal_lidar = R_lidar_target * normal_material.xyz;
+  float cos_incidence = abs(dot(normal_lidar, position_lidar)) / range;
+  range_cos_material = vec4(range, cos_incidence, normal_material.w, 0.0);
+}
+)";
+
+bool hasExtension(const char* list, const char* name) {
+  if (list == nullptr) return false;
+  const size_t length = std::strlen(name);
+  for (const char* p = std::strstr(list, name); p != nullptr; p = std::strstr(p + 1, name)) {
+    const bool starts = p == list || p[-1] == ' ';
+    const bool ends = p[length] == '\0' || p[length] == ' ';
+    if (starts && ends) return true;
+  }
+  return false;
+}
+
+template <typename F>
+F eglProc(const char* name) {
+  return reinterpret_cast<F>(eglGetProcAddress(name));
+}
+
+std::string eglErrorText(const std::string& what) {
+  char code[16];
+  std::snprintf(code, sizeof(code), "0x%04x", eglGetError());
+  return "EGL: " + what + " failed (error " + code + ")";
+}
+
+GLuint compileShader(GLenum type, const char* source) {
+  const GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    std::array<char, 4096> log{};
+    glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    glDeleteShader(shader);
+    throw std::runtime_error(std::string("OpenGL shader compilation failed: ") + log.data());
+  }
+  return shader;
+}
+
+struct Chunk {
+  std::size_t first_triangle = 0;
+  std::size_t triangle_count = 0;
+  Eigen::Vector3d centre_target = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;
+};
+
+// Recursive median split on triangle centroids along the longest axis of their bounding box, so each chunk is
+// spatially compact and can be culled as a whole.
+void splitIntoChunks(const std::vector<Eigen::Vector3f>& centroids, std::vector<std::size_t>::iterator begin,
+                     std::vector<std::size_t>::iterator end, std::size_t max_triangles,
+                     std::vector<std::pair<std::size_t, std::size_t>>* ranges, std::size_t offset) {
+  const std::size_t count = static_cast<std::size_t>(end - begin);
+  if (count <= max_triangles) {
+    ranges->emplace_back(offset, count);
+    return;
+  }
+  Eigen::AlignedBox3f box;
+  for (auto it = begin; it != end; ++it) box.extend(centroids[*it]);
+  int axis = 0;
+  box.sizes().maxCoeff(&axis);
+  const auto middle = begin + static_cast<std::ptrdiff_t>(count / 2);
+  std::nth_element(begin, middle, end,
+                   [&](std::size_t a, std::size_t b) { return centroids[a][axis] < centroids[b][axis]; });
+  splitIntoChunks(centroids, begin, middle, max_triangles, ranges, offset);
+  splitIntoChunks(centroids, middle, end, max_triangles, ranges, offset + count / 2);
+}
+
+}  // namespace
+
+EglPlatform parseEglPlatform(const std::string& name) {
+  if (name == "auto") return EglPlatform::kAuto;
+  if (name == "device") return EglPlatform::kDevice;
+  if (name == "surfaceless") return EglPlatform::kSurfaceless;
+  throw std::invalid_argument("egl_platform '" + name + "' is not one of: auto, device, surfaceless");
+}
+
+struct EglRenderer::Impl {
+  SensorOptions sensor;
+  RendererOptions options;
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext context = EGL_NO_CONTEXT;
+  std::string gl_renderer;
+  std::string egl_platform;
+  std::mutex mutex;
+
+  GLuint program = 0;
+  GLuint vertex_array = 0;
+  GLuint vertex_buffer = 0;
+  GLuint index_buffer = 0;
+  GLuint triangle_buffer = 0;
+  GLuint triangle_texture = 0;
+  GLuint framebuffer = 0;
+  GLuint colour_renderbuffer = 0;
+  GLuint depth_renderbuffer = 0;
+  GLint uniform_T_lidar_target = -1;
+  GLint uniform_projection = -1;
+  GLint uniform_R_lidar_target = -1;
+  GLint uniform_first_triangle = -1;
+  GLint uniform_triangle_buffer = -1;
+
+  std::vector<Chunk> chunks;
+  std::size_t triangles_drawn = 0;
+  std::array<float, 16> projection{};  // column-major
+  std::array<Eigen::Vector3d, 4>
+      side_plane_normals;  // inward normals of the frustum's side planes, lidar frame
+  double far_plane_m = 0.0;
+
+  // Makes the context current for the lifetime of the object and releases it after (any thread may call
+  // next).
+  class Current {
+   public:
+    explicit Current(Impl& impl) : impl_(impl), lock_(impl.mutex) {
+      if (!eglMakeCurrent(impl_.display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_.context))
+        throw std::runtime_error(eglErrorText("eglMakeCurrent"));
+    }
+    ~Current() { eglMakeCurrent(impl_.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+
+   private:
+    Impl& impl_;
+    std::lock_guard<std::mutex> lock_;
+  };
+
+  void openDisplay() {
+    const char* client_extensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    auto getPlatformDisplay = eglProc<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
+    if (getPlatformDisplay == nullptr)
+      throw std::runtime_error("EGL: eglGetPlatformDisplayEXT is not available");
+
+    if (options.platform != EglPlatform::kSurfaceless &&
+        hasExtension(client_extensions, "EGL_EXT_platform_device")) {
+      auto queryDevices = eglProc<PFNEGLQUERYDEVICESEXTPROC>("eglQueryDevicesEXT");
+      auto queryDeviceString = eglProc<PFNEGLQUERYDEVICESTRINGEXTPROC>("eglQueryDeviceStringEXT");
+      std::array<EGLDeviceEXT, 16> devices{};
+      EGLint device_count = 0;
+      if (queryDevices != nullptr && queryDeviceString != nullptr &&
+          queryDevices(static_cast<EGLint>(devices.size()), devices.data(), &device_count)) {
+        for (EGLint i = 0; i < device_count && display == EGL_NO_DISPLAY; ++i) {
+          // Mesa lists its software rasteriser as a device too; only a hardware device is worth this path.
+          if (hasExtension(queryDeviceString(devices[i], EGL_EXTENSIONS), "EGL_MESA_device_software"))
+            continue;
+          EGLDisplay candidate = getPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+          if (candidate != EGL_NO_DISPLAY && eglInitialize(candidate, nullptr, nullptr)) {
+            display = candidate;
+            egl_platform = "device";
+          }
+        }
+      }
+    }
+    if (display == EGL_NO_DISPLAY && options.platform != EglPlatform::kDevice &&
+        hasExtension(client_extensions, "EGL_MESA_platform_surfaceless")) {
+      EGLDisplay candidate = getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+      if (candidate != EGL_NO_DISPLAY && eglInitialize(candidate, nullptr, nullptr)) {
+        display = candidate;
+        egl_platform = "surfaceless";
+      }
+    }
+    if (display == EGL_NO_DISPLAY) {
+      throw std::runtime_error(
+          "EGL: no usable display (wanted a hardware EGL device or Mesa's surfaceless platform; client "
+          "extensions: " +
+          std::string(client_extensions ? client_extensions : "none") + ")");
+    }
+  }
+
+  void createContext() {
+    if (!hasExtension(eglQueryString(display, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context"))
+      throw std::runtime_error("EGL: the display lacks EGL_KHR_surfaceless_context");
+    if (!eglBindAPI(EGL_OPENGL_API)) throw std::runtime_error(eglErrorText("eglBindAPI(EGL_OPENGL_API)"));
+    const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
+                                        EGL_OPENGL_BIT, EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint config_count = 0;
+    if (!eglChooseConfig(display, config_attributes, &config, 1, &config_count) || config_count < 1)
+      throw std::runtime_error(eglErrorText("eglChooseConfig (desktop OpenGL)"));
+    const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                         3,
+                                         EGL_CONTEXT_MINOR_VERSION,
+                                         3,
+                                         EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                         EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                         EGL_NONE};
+    context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attributes);
+    if (context == EGL_NO_CONTEXT)
+      throw std::runtime_error(eglErrorText("eglCreateContext (OpenGL 3.3 core)"));
+  }
+
+  void createPipeline() {
+    gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    GLint major = 0;
+    GLint minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    bool clip_control = major > 4 || (major == 4 && minor >= 5);
+    GLint extension_count = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &extension_count);
+    for (GLint i = 0; i < extension_count && !clip_control; ++i)
+      clip_control = std::strcmp(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i)),
+                                 "GL_ARB_clip_control") == 0;
+    if (!clip_control)
+      throw std::runtime_error("OpenGL: " + gl_renderer +
+                               " lacks glClipControl (GL 4.5 or GL_ARB_clip_control)");
+
+    const GLuint vertex_shader = compileShader(GL_VERTEX_SHADER, kVertexShader);
+    const GLuint fragment_shader = compileShader(GL_FRAGMENT_SHADER, kFragmentShader);
+    program = glCreateProgram();
+    glAttachShader(program, vertex_shader);
+    glAttachShader(program, fragment_shader);
+    glLinkProgram(program);
+    glDeleteShader(vertex_shader);
+    glDeleteShader(fragment_shader);
+    GLint linked = GL_FALSE;
+    glGetProgramiv(program, GL_LINK_STATUS, &linked);
+    if (linked != GL_TRUE) throw std::runtime_error("OpenGL: shader program failed to link");
+    uniform_T_lidar_target = glGetUniformLocation(program, "T_lidar_target");
+    uniform_projection = glGetUniformLocation(program, "projection");
+    uniform_R_lidar_target = glGetUniformLocation(program, "R_lidar_target");
+    uniform_first_triangle = glGetUniformLocation(program, "first_triangle");
+    uniform_triangle_buffer = glGetUniformLocation(program, "triangle_normal_material");
+
+    glGenVertexArrays(1, &vertex_array);
+    glGenBuffers(1, &vertex_buffer);
+    glGenBuffers(1, &index_buffer);
+    glGenBuffers(1, &triangle_buffer);
+    glGenTextures(1, &triangle_texture);
+
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glGenRenderbuffers(1, &colour_renderbuffer);
+    glBindRenderbuffer(GL_RENDERBUFFER, colour_renderbuffer);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, sensor.width, sensor.height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_renderbuffer);
+    glGenRenderbuffers(1, &depth_renderbuffer);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_renderbuffer);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, sensor.width, sensor.height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_renderbuffer);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("OpenGL: RGBA32F + DEPTH_COMPONENT32F framebuffer is incomplete on " +
+                               gl_renderer);
+
+    // Reversed Z: depth = near / z (1 at the near plane, near / far at the far plane) with a float depth
+    // buffer.
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glClearDepth(0.0);
+    // The image's y axis points down and row 0 is read back first, so the window is the image flipped
+    // vertically and a triangle that is counter-clockwise seen from outside arrives clockwise.
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CW);
+    glViewport(0, 0, sensor.width, sensor.height);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  }
+
+  void setUpProjection() {
+    const Intrinsics k = intrinsicsFor(sensor);
+    const double near_m = sensor.near_plane_m;
+    // A point beyond max_range has z > max_range only if it is on the boresight; any z > max_range is out of
+    // range.
+    far_plane_m = sensor.max_range_m * 1.001;
+    const double b = near_m * far_plane_m / (far_plane_m - near_m);
+    const double a = -near_m / (far_plane_m - near_m);
+    projection.fill(0.0f);
+    projection[0] = static_cast<float>(2.0 * k.fx / k.width);
+    projection[5] = static_cast<float>(2.0 * k.fy / k.height);
+    projection[10] = static_cast<float>(a);
+    projection[11] = 1.0f;  // w = z (the sensor looks along +z)
+    projection[14] = static_cast<float>(b);
+    // Inward normals of the side planes through the pixel-edge rays at the image border.
+    const double tan_x = 0.5 * k.width / k.fx;
+    const double tan_y = 0.5 * k.height / k.fy;
+    side_plane_normals = {
+        Eigen::Vector3d(1.0, 0.0, tan_x).normalized(), Eigen::Vector3d(-1.0, 0.0, tan_x).normalized(),
+        Eigen::Vector3d(0.0, 1.0, tan_y).normalized(), Eigen::Vector3d(0.0, -1.0, tan_y).normalized()};
+  }
+
+  bool chunkVisible(const Chunk& chunk, const Eigen::Isometry3d& T_lidar_target) const {
+    const Eigen::Vector3d centre = T_lidar_target * chunk.centre_target;
+    if (centre.z() + chunk.radius_m < sensor.near_plane_m || centre.z() - chunk.radius_m > far_plane_m)
+      return false;
+    for (const Eigen::Vector3d& normal : side_plane_normals)
+      if (normal.dot(centre) < -chunk.radius_m) return false;
+    return true;
+  }
+};
+
+EglRenderer::EglRenderer(const SensorOptions& sensor, const RendererOptions& options) : impl_(new Impl) {
+  validate(sensor);
+  if (options.triangles_per_chunk < 1)
+    throw std::invalid_argument(
+        "parameter triangles_per_chunk = " + std::to_string(options.triangles_per_chunk) +
+        " is out of range: allowed >= 1");
+  impl_->sensor = sensor;
+  impl_->options = options;
+  impl_->openDisplay();
+  impl_->createContext();
+  Impl::Current current(*impl_);
+  impl_->createPipeline();
+  impl_->setUpProjection();
+}
+
+EglRenderer::~EglRenderer() {
+  if (impl_->display == EGL_NO_DISPLAY) return;
+  if (impl_->context != EGL_NO_CONTEXT) {
+    if (eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context)) {
+      glDeleteProgram(impl_->program);
+      glDeleteVertexArrays(1, &impl_->vertex_array);
+      const GLuint buffers[] = {impl_->vertex_buffer, impl_->index_buffer, impl_->triangle_buffer};
+      glDeleteBuffers(3, buffers);
+      glDeleteTextures(1, &impl_->triangle_texture);
+      const GLuint renderbuffers[] = {impl_->colour_renderbuffer, impl_->depth_renderbuffer};
+      glDeleteRenderbuffers(2, renderbuffers);
+      glDeleteFramebuffers(1, &impl_->framebuffer);
+      eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
+    eglDestroyContext(impl_->display, impl_->context);
+  }
+  eglTerminate(impl_->display);
+}
+
+void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
+  const std::size_t triangle_count = mesh.triangles.size();
+  if (mesh.triangle_material.size() != triangle_count)
+    throw std::invalid_argument("mesh: triangle_material has " +
+                                std::to_string(mesh.triangle_material.size()) + " entries for " +
+                                std::to_string(triangle_count) + " triangles");
+  for (const Eigen::Vector3i& triangle : mesh.triangles)
+    for (int corner = 0; corner < 3; ++corner)
+      if (triangle[corner] < 0 || static_cast<std::size_t>(triangle[corner]) >= mesh.vertices.size())
+        throw std::invalid_argument("mesh: triangle vertex index " + std::to_string(triangle[corner]) +
+                                    " is outside the " + std::to_string(mesh.vertices.size()) + " vertices");
+
+  std::vector<Eigen::Vector3f> centroids(triangle_count);
+  for (std::size_t t = 0; t < triangle_count; ++t) {
+    const Eigen::Vector3i& tri = mesh.triangles[t];
+    centroids[t] = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0f;
+  }
+  std::vector<std::size_t> order(triangle_count);
+  std::iota(order.begin(), order.end(), 0);
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  if (triangle_count > 0)
+    splitIntoChunks(centroids, order.begin(), order.end(),
+                    static_cast<std::size_t>(impl_->options.triangles_per_chunk), &ranges, 0);
+
+  std::vector<GLuint> indices;
+  indices.reserve(3 * triangle_count);
+  std::vector<Eigen::Vector4f> normal_material;
+  normal_material.reserve(triangle_count);
+  for (std::size_t t : order) {
+    const Eigen::Vector3i& tri = mesh.triangles[t];
+    for (int corner = 0; corner < 3; ++corner) indices.push_back(static_cast<GLuint>(tri[corner]));
+    const Eigen::Vector3f normal = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
+                                       .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]])
+                                       .normalized();
+    normal_material.emplace_back(normal.x(), normal.y(), normal.z(),
+                                 static_cast<float>(mesh.triangle_material[t]));
+  }
+  std::vector<Chunk> chunks;
+  for (const auto& [first, count] : ranges) {
+    Eigen::AlignedBox3d box;
+    for (std::size_t i = first; i < first + count; ++i)
+      for (int corner = 0; corner < 3; ++corner)
+        box.extend(mesh.vertices[indices[3 * i + corner]].cast<double>());
+    chunks.push_back({first, count, box.center(), 0.5 * box.diagonal().norm()});
+  }
+
+  Impl::Current current(*impl_);
+  glBindVertexArray(impl_->vertex_array);
+  glBindBuffer(GL_ARRAY_BUFFER, impl_->vertex_buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(Eigen::Vector3f)),
+               mesh.vertices.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Eigen::Vector3f), nullptr);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->index_buffer);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)),
+               indices.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_TEXTURE_BUFFER, impl_->triangle_buffer);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(normal_material.size() * sizeof(Eigen::Vector4f)),
+               normal_material.data(), GL_STATIC_DRAW);
+  glBindTexture(GL_TEXTURE_BUFFER, impl_->triangle_texture);
+  glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, impl_->triangle_buffer);
+  impl_->chunks = std::move(chunks);
+  if (glGetError() != GL_NO_ERROR) throw std::runtime_error("OpenGL: uploading the mesh failed");
+}
+
+void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame) {
+  Impl& impl = *impl_;
+  Impl::Current current(impl);
+  // Double precision up to here; the float matrix only carries target-frame vertices of a few tens of metres.
+  const Eigen::Matrix4f T = T_lidar_target.matrix().cast<float>();
+  const Eigen::Matrix3f R = T_lidar_target.linear().cast<float>();
+
+  glBindFramebuffer(GL_FRAMEBUFFER, impl.framebuffer);
+  const GLfloat no_surface[] = {0.0f, 0.0f, -1.0f, 0.0f};
+  glClearBufferfv(GL_COLOR, 0, no_surface);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  impl.triangles_drawn = 0;
+  if (!impl.chunks.empty()) {
+    glUseProgram(impl.program);
+    glUniformMatrix4fv(impl.uniform_T_lidar_target, 1, GL_FALSE, T.data());
+    glUniformMatrix4fv(impl.uniform_projection, 1, GL_FALSE, impl.projection.data());
+    glUniformMatrix3fv(impl.uniform_R_lidar_target, 1, GL_FALSE, R.data());
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_BUFFER, impl.triangle_texture);
+    glUniform1i(impl.uniform_triangle_buffer, 0);
+    glBindVertexArray(impl.vertex_array);
+    // Visible chunks are merged into contiguous runs, one draw call per run.
+    std::size_t run_first = 0;
+    std::size_t run_count = 0;
+    auto flush = [&]() {
+      if (run_count == 0) return;
+      glUniform1i(impl.uniform_first_triangle, static_cast<GLint>(run_first));
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * run_count), GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(3 * run_first * sizeof(GLuint)));
+      impl.triangles_drawn += run_count;
+      run_count = 0;
+    };
+    for (const Chunk& chunk : impl.chunks) {
+      if (!impl.chunkVisible(chunk, T_lidar_target)) {
+        flush();
+        continue;
+      }
+      if (run_count == 0) run_first = chunk.first_triangle;
+      run_count += chunk.triangle_count;
+    }
+    flush();
+  }
+  frame->width = impl.sensor.width;
+  frame->height = impl.sensor.height;
+  frame->pixels.resize(static_cast<std::size_t>(impl.sensor.width) * impl.sensor.height);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, impl.sensor.width, impl.sensor.height, GL_RGBA, GL_FLOAT, frame->pixels.data());
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR)
+    throw std::runtime_error("OpenGL: rendering failed with error " + std::to_string(error));
+}
+
+const std::string& EglRenderer::glRenderer() const {
+  return impl_->gl_renderer;
+}
+const std::string& EglRenderer::eglPlatform() const {
+  return impl_->egl_platform;
+}
+std::size_t EglRenderer::trianglesDrawnLastFrame() const {
+  return impl_->triangles_drawn;
+}
+
+}  // namespace ardsim_lidar
