@@ -1,0 +1,126 @@
+#include "ardsim_dynamics/simulation.h"
+
+#include <cmath>
+
+namespace ardsim_dynamics {
+namespace {
+
+Environment makeEnvironment(const Scenario& s) {
+  GravityField field =
+      s.gravity_model_file.empty() ? GravityField::egm96() : GravityField::fromFile(s.gravity_model_file);
+  return Environment(std::move(field), s.environment);
+}
+
+// Docking attitude: chaser port x anti-parallel to target port x (a half turn about the port z axis).
+const Eigen::Matrix3d& R_targetport_chaserport_docked() {
+  static const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return R;
+}
+
+}  // namespace
+
+Eigen::Isometry3d poseOf(const VehicleState& state) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = state.attitude.toRotationMatrix();
+  T.translation() = state.position_m;
+  return T;
+}
+
+InitialStates initialStates(const Scenario& s) {
+  using ardsim_description::T_chaser_port;
+  using ardsim_description::T_target_port;
+  InitialStates out;
+  const CartesianState target_orbit = keplerianToCartesian(s.target_orbit);
+  out.target.position_m = target_orbit.position_m;
+  out.target.velocity_mps = target_orbit.velocity_mps;
+  const Eigen::Matrix3d R_eci_lvlh = ardsim_dynamics::R_eci_lvlh(target_orbit);
+  const Eigen::Matrix3d R_lvlh_target = rotationFromRollPitchYaw(s.target_attitude_offset_rad);
+  out.target.attitude = Eigen::Quaterniond(R_eci_lvlh * R_lvlh_target);
+  // Rotating with LVLH: the LVLH rate, in body axes.
+  out.target.angular_velocity_radps = R_lvlh_target.transpose() * lvlhRate(target_orbit);
+
+  const Eigen::Isometry3d T_eci_target = poseOf(out.target);
+  const Eigen::Isometry3d T_target_port_ = T_target_port(s.target_kind);
+  const Eigen::Matrix3d R_offset = rotationFromRollPitchYaw(s.chaser_initial.attitude_offset_rad);
+  const Eigen::Vector3d omega_target_eci = out.target.attitude * out.target.angular_velocity_radps;
+
+  Eigen::Isometry3d T_eci_chaser;
+  Eigen::Vector3d v_chaser;
+  if (s.chaser_initial.frame == RelativeFrame::kTargetPort) {
+    Eigen::Isometry3d T_tp_cp = Eigen::Isometry3d::Identity();
+    T_tp_cp.linear() = R_targetport_chaserport_docked() * R_offset;
+    T_tp_cp.translation() = s.chaser_initial.position_m;
+    T_eci_chaser = T_eci_target * T_target_port_ * T_tp_cp * T_chaser_port().inverse();
+    const Eigen::Matrix3d R_eci_tp = (T_eci_target * T_target_port_).linear();
+    v_chaser = out.target.velocity_mps +
+               omega_target_eci.cross(T_eci_chaser.translation() - out.target.position_m) +
+               R_eci_tp * s.chaser_initial.velocity_mps;
+  } else {
+    const CartesianState chaser = inertialFromLvlh(
+        target_orbit, CartesianState{s.chaser_initial.position_m, s.chaser_initial.velocity_mps});
+    T_eci_chaser = Eigen::Isometry3d::Identity();
+    // Docking attitude relative to the target's attitude, then the offset.
+    const Eigen::Matrix3d R_target_chaser = T_target_port_.linear() * R_targetport_chaserport_docked() *
+                                            R_offset * T_chaser_port().linear().transpose();
+    T_eci_chaser.linear() = T_eci_target.linear() * R_target_chaser;
+    T_eci_chaser.translation() = chaser.position_m;
+    v_chaser = chaser.velocity_mps;
+  }
+  out.chaser.position_m = T_eci_chaser.translation();
+  out.chaser.velocity_mps = v_chaser;
+  out.chaser.attitude = Eigen::Quaterniond(T_eci_chaser.linear());
+  out.chaser.angular_velocity_radps =
+      T_eci_chaser.linear().transpose() * omega_target_eci + s.chaser_initial.angular_rate_offset_radps;
+  return out;
+}
+
+Simulation::Simulation(const Scenario& scenario)
+    : scenario_(scenario),
+      environment_(makeEnvironment(scenario)),
+      actuator_(scenario.chaser_actuator, scenario.seed("actuator")) {
+  const InitialStates initial = initialStates(scenario_);
+  target_ = initial.target;
+  chaser_ = initial.chaser;
+  substeps_ = static_cast<int>(std::lround(scenario_.control_step_s / scenario_.integration_step_s));
+}
+
+BodyWrench Simulation::step(const BodyWrench& chaser_commanded) {
+  const BodyWrench applied = actuator_.apply(chaser_commanded, scenario_.control_step_s);
+  const double h = scenario_.integration_step_s;
+  const double t0 = time();
+  for (int i = 0; i < substeps_; ++i) {
+    const double t = t0 + i * h;
+    target_ = rk4Step(environment_, scenario_.target, target_, BodyWrench{}, t, h);
+    chaser_ = rk4Step(environment_, scenario_.chaser, chaser_, applied, t, h);
+  }
+  ++step_index_;
+  return applied;
+}
+
+CartesianState Simulation::chaserInTargetLvlh() const {
+  return relativeStateInLvlh(CartesianState{target_.position_m, target_.velocity_mps},
+                             CartesianState{chaser_.position_m, chaser_.velocity_mps});
+}
+
+RelativeState Simulation::chaserPortInTargetPort() const {
+  const Eigen::Isometry3d T_eci_tp =
+      poseOf(target_) * ardsim_description::T_target_port(scenario_.target_kind);
+  const Eigen::Isometry3d T_chaser_cp = ardsim_description::T_chaser_port();
+  const Eigen::Isometry3d T_eci_cp = poseOf(chaser_) * T_chaser_cp;
+  RelativeState rel;
+  // Compose from differences so that the 7e6 m eci positions cancel before rounding matters.
+  rel.pose.linear() = T_eci_tp.linear().transpose() * T_eci_cp.linear();
+  rel.pose.translation() = T_eci_tp.linear().transpose() * (T_eci_cp.translation() - T_eci_tp.translation());
+  const Eigen::Vector3d omega_t = target_.attitude * target_.angular_velocity_radps;
+  const Eigen::Vector3d omega_c = chaser_.attitude * chaser_.angular_velocity_radps;
+  const Eigen::Vector3d v_cp =
+      chaser_.velocity_mps + omega_c.cross(T_eci_cp.translation() - chaser_.position_m);
+  // Velocity of the target-fixed point that coincides with the chaser port.
+  const Eigen::Vector3d v_fixed =
+      target_.velocity_mps + omega_t.cross(T_eci_cp.translation() - target_.position_m);
+  rel.velocity_mps = T_eci_tp.linear().transpose() * (v_cp - v_fixed);
+  rel.angular_velocity_radps = T_eci_tp.linear().transpose() * (omega_c - omega_t);
+  return rel;
+}
+
+}  // namespace ardsim_dynamics
