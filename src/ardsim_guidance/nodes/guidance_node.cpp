@@ -70,6 +70,7 @@ GuidanceOptions loadOptions(const ros::NodeHandle& pnh, double* own_state_timeou
   get("approach/contact_speed_mps", a.contact_speed_mps);
   pnh.param("approach/hold_ranges_m", a.hold_ranges_m, a.hold_ranges_m);
   pnh.param("approach/hold_durations_s", a.hold_durations_s, a.hold_durations_s);
+  get("approach/hold_approach_time_constant_s", a.hold_approach_time_constant_s);
   get("approach/bandwidth_rad_s", a.bandwidth_rad_s);
   get("approach/damping_ratio", a.damping_ratio);
   get("approach/integral_time_s", a.integral_time_s);
@@ -103,8 +104,9 @@ class GuidanceNode {
  public:
   GuidanceNode(ros::NodeHandle& nh, const GuidanceOptions& options, double own_state_timeout_s)
       : guidance_(options), own_state_timeout_s_(own_state_timeout_s) {
-    command_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("guidance/command", 100);
-    state_pub_ = nh.advertise<ardsim_msgs::GuidanceState>("guidance/state", 100);
+    // Latched: the dynamics gets the command of the current step even if it connects after it was sent.
+    command_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("guidance/command", 100, true);
+    state_pub_ = nh.advertise<ardsim_msgs::GuidanceState>("guidance/state", 100, true);
     odom_sub_ = nh.subscribe("truth/chaser/odom", 100, &GuidanceNode::onOdometry, this);
     estimate_sub_ = nh.subscribe("pose/estimate", 100, &GuidanceNode::onEstimate, this);
     // Deadlock breaker only: an estimate whose own-state message never comes is answered after a wall

@@ -40,7 +40,8 @@ class TruthPoseNode {
  public:
   TruthPoseNode(ros::NodeHandle& nh, const TruthPoseOptions& options, ardsim_description::TargetKind target)
       : options_(options), generator_(options, VehicleFrames::fromDescription(target)) {
-    pub_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 100);
+    // Latched: a subscriber that connects late still gets the estimate of the current lockstep step.
+    pub_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 100, true);
     target_sub_ = nh.subscribe<nav_msgs::Odometry>(
         "truth/target/odom", 100, [this](const nav_msgs::Odometry::ConstPtr& m) { on(m, 0); });
     chaser_sub_ = nh.subscribe<nav_msgs::Odometry>(

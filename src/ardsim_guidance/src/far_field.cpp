@@ -33,10 +33,12 @@ Eigen::Vector3d FarFieldTargeting::step(double time_s, double dt, double n, cons
   } else if (arrived_ && pending_dv_mps_.isZero()) {
     retarget(time_s, n, r, v, r_aim, v_aim,
              std::max(options_.retarget_interval_s, options_.min_retarget_time_s));
-  } else if (!arrived_ && time_s - last_target_time_s_ >= options_.retarget_interval_s &&
+  } else if (!arrived_ &&
+             (retarget_requested_ || time_s - last_target_time_s_ >= options_.retarget_interval_s) &&
              arrival_time_s_ - time_s >= options_.min_retarget_time_s) {
     retarget(time_s, n, r, v, r_aim, v_aim, arrival_time_s_ - time_s);
   }
+  retarget_requested_ = false;
   if (!(dt > 0.0)) return Eigen::Vector3d::Zero();
   const double a_max = options_.burn_accel_mps2;
   const Eigen::Vector3d accel = (pending_dv_mps_ / dt).cwiseMax(-a_max).cwiseMin(a_max);

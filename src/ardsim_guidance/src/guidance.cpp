@@ -91,6 +91,7 @@ void validate(const GuidanceOptions& o) {
     require("approach/hold_ranges_m[" + std::to_string(i) + "]", a.hold_ranges_m[i], 0.0, kInf);
     require("approach/hold_durations_s[" + std::to_string(i) + "]", a.hold_durations_s[i], 0.0, kInf, true);
   }
+  require("approach/hold_approach_time_constant_s", a.hold_approach_time_constant_s, 0.0, kInf);
   require("approach/bandwidth_rad_s", a.bandwidth_rad_s, 0.0, 0.5 * M_PI / o.control_period_s);
   require("approach/damping_ratio", a.damping_ratio, 0.0, 5.0, false, true);
   require("approach/integral_time_s", a.integral_time_s, 0.0, kInf);
@@ -242,17 +243,17 @@ GuidanceOutput Guidance::step(const EstimateInput& estimate, const OwnState* own
     out.phase = Phase::kRetreat;
     out.reason = decision.reason;
   } else if (decision.action == SafetyAction::kHold) {
-    // Station-keeping: in the near field on the frozen approach reference, in the far field where the hold
-    // began.
     if (near_field_) {
+      // Station-keeping on the frozen approach reference.
       approach_reference_.advance(dt, true);
       ref_p = approach_reference_.position();
+      accel_lvlh = R_lvlh_tp * tracker_.command(period, p, v, ref_p, ref_v, free_accel_tp, false);
     } else {
-      if (phase_ != Phase::kHold) hold_reference_m_ = p;
-      far_field_.stop();  // a fresh transfer is planned when the estimate is back
-      ref_p = hold_reference_m_;
+      // Far field: coast on the CW transfer (it is a free trajectory); burns wait, and the transfer is
+      // re-targeted from the state at the next usable estimate.
+      far_field_.requestRetarget();
+      ref_p = approachAxisPoint(options_.far_field.aim_range_m);
     }
-    accel_lvlh = R_lvlh_tp * tracker_.command(period, p, v, ref_p, ref_v, free_accel_tp, false);
     out.phase = Phase::kHold;
     out.reason = decision.reason;
   } else if (!near_field_ && p.x() > options_.near_field_range_m) {

@@ -25,6 +25,8 @@ class FarFieldTargeting {
   explicit FarFieldTargeting(const FarFieldOptions& options = {}) : options_(options) {}
   bool active() const { return active_; }
   void stop() { active_ = false; }
+  // Re-target at the next step (after a HOLD), if enough transfer time is left.
+  void requestRetarget() { retarget_requested_ = true; }
 
   // Commanded acceleration for the step starting at time_s: plans a transfer on the first call, re-targets at
   // intervals, and flies the pending impulse. r_com/v: current relative state; r_aim/v_aim: aim point and the
@@ -45,6 +47,7 @@ class FarFieldTargeting {
   FarFieldOptions options_;
   bool active_ = false;
   bool arrived_ = false;
+  bool retarget_requested_ = false;
   double arrival_time_s_ = 0.0;
   double last_target_time_s_ = 0.0;
   TwoImpulseTransfer plan_;

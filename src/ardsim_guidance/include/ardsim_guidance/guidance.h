@@ -129,7 +129,6 @@ class Guidance {
   double delta_v_mps_ = 0.0;
   Phase phase_ = Phase::kWait;
   bool near_field_ = false;
-  Eigen::Vector3d hold_reference_m_{0, 0, 0};     // far-field hold point (target_port)
   Eigen::Vector3d retreat_reference_m_{0, 0, 0};  // retreat reference point (target_port)
 };
 
