@@ -18,12 +18,17 @@ CHASER_MASS_KG = 12519.0  # free_drift.yaml
 class Lockstep(unittest.TestCase):
     def setUp(self):
         self.lock = threading.Condition()
-        self.chaser, self.relative, self.applied, self.clock = {}, {}, {}, []
+        self.chaser, self.relative, self.applied, self.clock = {}, {}, {}, {}
         rospy.Subscriber("truth/chaser/odom", Odometry, self.store(self.chaser), queue_size=100)
         rospy.Subscriber("truth/relative", Odometry, self.store(self.relative), queue_size=100)
         rospy.Subscriber("dynamics/applied_wrench", WrenchStamped, self.store(self.applied), queue_size=100)
-        rospy.Subscriber("/clock", Clock, lambda m: self.clock.append(m.clock.to_nsec()), queue_size=100)
+        rospy.Subscriber("/clock", Clock, self.on_clock, queue_size=100)
         self.command_pub = rospy.Publisher("guidance/command", WrenchStamped, queue_size=10, latch=True)
+
+    def on_clock(self, msg):
+        with self.lock:
+            self.clock[msg.clock.to_nsec()] = msg
+            self.lock.notify_all()
 
     def store(self, table):
         def callback(msg):
@@ -46,8 +51,11 @@ class Lockstep(unittest.TestCase):
             self.assertEqual(truth.header.frame_id, "eci")
             self.assertEqual(truth.child_frame_id, "chaser")
             self.wait_for(self.relative, stamp.to_nsec())
-            # The clock says t_k while the step is open.
-            self.assertEqual(self.clock[-1], stamp.to_nsec())
+            # The clock says t_k while the step is open (topics arrive in any order: wait for it, then check nothing
+            # later came).
+            self.wait_for(self.clock, stamp.to_nsec())
+            with self.lock:
+                self.assertEqual(max(self.clock), stamp.to_nsec())
             if k < 3:
                 # It must wait for the command: nothing newer appears in the meantime.
                 time.sleep(0.5)
