@@ -4,6 +4,7 @@
 // (chaser_port in target_port), tf eci->{ecef, target_lvlh, target, chaser}; then waits for guidance/command
 // stamped t_k, applies it through the actuator model over [t_k, t_k + dt] (published on
 // dynamics/applied_wrench, stamped t_k) and advances.
+#include <ardsim_msgs/log_throttle.h>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -19,7 +20,6 @@
 
 #include "ardsim_dynamics/simulation.h"
 #include "conversions.h"
-#include "log_throttle.h"
 
 namespace ardsim_dynamics {
 namespace {

@@ -1,6 +1,7 @@
 // guidance_node: one guidance/command (and one guidance/state) per pose/estimate, stamped with the estimate's
 // stamp. Reads the chaser's own inertial state from truth/chaser/odom (standing in for its GPS, star tracker
 // and gyros); never any relative truth. Parameters: config/guidance.yaml.
+#include <ardsim_msgs/log_throttle.h>
 #include <deque>
 #include <map>
 #include <vector>
@@ -124,8 +125,8 @@ class GuidanceNode {
     OwnState state;
     std::string why;
     if (!fromOdometry(*msg, &state, &why)) {
-      ROS_WARN_THROTTLE(5.0, "guidance: ignoring malformed truth/chaser/odom at %.3f s: %s",
-                        msg->header.stamp.toSec(), why.c_str());
+      ARDSIM_WARN_THROTTLE(5.0, "guidance: ignoring malformed truth/chaser/odom at %.3f s: %s",
+                           msg->header.stamp.toSec(), why.c_str());
       return;
     }
     own_states_[msg->header.stamp] = state;
@@ -155,8 +156,8 @@ class GuidanceNode {
         // The latest own state not after the estimate, if any.
         auto it = own_states_.upper_bound(stamp);
         if (it != own_states_.begin()) own = &std::prev(it)->second;
-        ROS_WARN_THROTTLE(5.0, "guidance: no truth/chaser/odom at the estimate's stamp %.3f s; using %s",
-                          stamp.toSec(), own ? "an earlier one" : "none (hold)");
+        ARDSIM_WARN_THROTTLE(5.0, "guidance: no truth/chaser/odom at the estimate's stamp %.3f s; using %s",
+                             stamp.toSec(), own ? "an earlier one" : "none (hold)");
       }
       answer(*p.msg, own);
       pending_.pop_front();
@@ -166,8 +167,8 @@ class GuidanceNode {
   void answer(const ardsim_msgs::PoseEstimate& msg, const OwnState* own) {
     const EstimateInput input = fromPoseEstimate(msg);
     if (!input.well_formed && input.status != EstimateStatus::kLost) {
-      ROS_WARN_THROTTLE(5.0, "guidance: %s at %.3f s; answering with a hold command", input.reason.c_str(),
-                        msg.header.stamp.toSec());
+      ARDSIM_WARN_THROTTLE(5.0, "guidance: %s at %.3f s; answering with a hold command", input.reason.c_str(),
+                           msg.header.stamp.toSec());
     }
     const GuidanceOutput out = guidance_.step(input, own);
     if (out.phase != last_phase_ || (out.phase == Phase::kRetreat && out.reason != last_reason_)) {

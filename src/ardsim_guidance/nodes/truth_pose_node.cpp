@@ -2,6 +2,7 @@
 // from truth/target/odom and truth/chaser/odom of the same stamp, with optional seeded noise, random dropouts
 // and scripted LOST intervals, so guidance can be tested without the LIDAR and pose chain. One estimate per
 // stamp for which both odometries arrived.
+#include <ardsim_msgs/log_throttle.h>
 #include <map>
 #include <vector>
 
@@ -68,8 +69,8 @@ class TruthPoseNode {
     // Stamps older than a matched pair will never match.
     pairs_.erase(pairs_.begin(), std::next(pairs_.find(stamp)));
     if (!ok) {
-      ROS_WARN_THROTTLE(5.0, "truth_pose: malformed odometry at %.3f s: %s; publishing LOST", stamp.toSec(),
-                        why.c_str());
+      ARDSIM_WARN_THROTTLE(5.0, "truth_pose: malformed odometry at %.3f s: %s; publishing LOST",
+                           stamp.toSec(), why.c_str());
       TruthPoseSample lost;
       lost.status = EstimateStatus::kLost;
       lost.reason = "truth_pose: malformed odometry";

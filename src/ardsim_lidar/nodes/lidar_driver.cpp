@@ -1,4 +1,5 @@
 #include "lidar_driver.h"
+#include <ardsim_msgs/log_throttle.h>
 
 #include <cmath>
 #include <limits>
@@ -153,8 +154,8 @@ void LidarDriver::onTruth(const nav_msgs::OdometryConstPtr& target,
   std::string error;
   if (!bodyPoseFromOdometry(*target, &T_eci_target, &error) ||
       !bodyPoseFromOdometry(*chaser, &T_eci_chaser, &error)) {
-    ROS_ERROR_THROTTLE(5.0, "lidar: bad truth at t = %.6f: %s; answering with an empty frame", stamp.toSec(),
-                       error.c_str());
+    ARDSIM_ERROR_THROTTLE(5.0, "lidar: bad truth at t = %.6f: %s; answering with an empty frame",
+                          stamp.toSec(), error.c_str());
     publish(empty_frame_, stamp, "bad truth: " + error, false);
     return;
   }
