@@ -275,6 +275,8 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
       }
     }
   }
+  // Sections read by the other nodes of a docking scenario; the dynamics leaves them to their owners.
+  for (const char* section : {"lidar", "pose", "guidance", "faults", "run"}) top.get(section);
   top.finish();
   return s;
 }

@@ -1,0 +1,46 @@
+// Types shared by every pose method (ICP, pyramid, docking ring), the mode manager and the nodes. ROS-free.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace ardsim_pose {
+
+// One organized LIDAR frame in lidar_optical: row-major, row 0 at the top (y down), a NaN point where there was no
+// return. The same layout as lidar/points.
+struct OrganizedCloud {
+  int width = 0;
+  int height = 0;
+  std::vector<Eigen::Vector3f> points;  // m
+  std::vector<float> intensity;         // same size as points (may be empty)
+  double stamp_s = 0.0;
+};
+
+enum class EstimateStatus { kTracking, kDegraded, kLost };
+enum class EstimateMethod { kNone, kIcp, kPyramid, kRing };
+
+struct PoseResult {
+  EstimateStatus status = EstimateStatus::kLost;
+  EstimateMethod method = EstimateMethod::kNone;
+  std::string reason;  // why DEGRADED or LOST
+  Eigen::Isometry3d T_lidar_target = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // (x y z, rot x y z) m^2, rad^2
+  bool boresight_rotation_observed = true;
+  double fit_rms_m = 0.0;
+  double inlier_fraction = 0.0;
+  int points_used = 0;
+  int iterations = 0;
+};
+
+// A method that estimates T_lidar_target in one frame from a prediction (previous estimates or the initial prior).
+class PoseMethod {
+ public:
+  virtual ~PoseMethod() = default;
+  virtual PoseResult estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_lidar_target_predicted) = 0;
+  // Forget any state carried between frames.
+  virtual void reset() = 0;
+};
+
+}  // namespace ardsim_pose
