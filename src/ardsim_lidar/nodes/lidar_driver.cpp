@@ -61,6 +61,9 @@ LidarNodeOptions loadOptions(const ros::NodeHandle& nh) {
   if (!std::isfinite(o.frame_rate_hz) || o.frame_rate_hz < 0.0)
     throw std::invalid_argument("parameter frame_rate_hz = " + std::to_string(o.frame_rate_hz) +
                                 " is out of range: >= 0 (0 = every truth step)");
+  read(nh, "faults/drop_intervals_s", &o.faults.drop_intervals_s);
+  read(nh, "faults/blind_intervals_s", &o.faults.blind_intervals_s);
+  validate(o.faults);
   read(nh, "frame_id", &o.frame_id);
   std::string platform = "auto";
   read(nh, "egl_platform", &platform);
@@ -132,6 +135,7 @@ LidarDriver::LidarDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
   const std::size_t pixels = static_cast<std::size_t>(options_.sensor.width) * options_.sensor.height;
   empty_frame_.range_m.assign(pixels, std::numeric_limits<float>::quiet_NaN());
   empty_frame_.intensity = empty_frame_.range_m;
+  fault_frame_ = empty_frame_;
   points_publisher_ = nh.advertise<sensor_msgs::PointCloud2>("lidar/points", 2);
   range_publisher_ = nh.advertise<sensor_msgs::Image>("lidar/range", 2);
   camera_info_publisher_ = nh.advertise<sensor_msgs::CameraInfo>("lidar/camera_info", 2);
@@ -157,6 +161,13 @@ void LidarDriver::onTruth(const nav_msgs::OdometryConstPtr& target,
     ARDSIM_ERROR_THROTTLE(5.0, "lidar: bad truth at t = %.6f: %s; answering with an empty frame",
                           stamp.toSec(), error.c_str());
     publish(empty_frame_, stamp, "bad truth: " + error, false);
+    return;
+  }
+  const SensorFault fault = faultAt(options_.faults, stamp.toSec());
+  if (fault != SensorFault::kNone) {
+    // A scripted fault (scenario): the step is still answered, with what the faulty sensor delivers.
+    applyFault(fault, &fault_frame_);
+    publish(fault_frame_, stamp, std::string("fault: ") + faultName(fault) + " frame", false);
     return;
   }
   const bool stale = options_.frame_rate_hz > 0.0 && have_frame_ &&

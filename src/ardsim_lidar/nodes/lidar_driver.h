@@ -13,6 +13,7 @@
 #include <ros/ros.h>
 
 #include "ardsim_description/models.h"
+#include "ardsim_lidar/fault_schedule.h"
 #include "ardsim_lidar/lidar_simulator.h"
 
 namespace ardsim_lidar {
@@ -30,6 +31,7 @@ struct LidarNodeOptions {
   // step that comes sooner than 1 / frame_rate_hz after the last new frame is answered with that frame,
   // re-stamped.
   double frame_rate_hz = 0.0;
+  FaultOptions faults;  // scripted sensor faults (scenario section `faults`)
 };
 
 // Reads every parameter from the private namespace, with the struct defaults as defaults, and validates them.
@@ -50,6 +52,7 @@ class LidarDriver {
   Eigen::Isometry3d T_chaser_lidar_;
   LidarFrame frame_;
   LidarFrame empty_frame_;
+  LidarFrame fault_frame_;
   ros::Time last_frame_time_;
   bool have_frame_ = false;
   message_filters::Subscriber<nav_msgs::Odometry> target_subscriber_;
