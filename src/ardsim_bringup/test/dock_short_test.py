@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""Closed loop, the whole graph (dynamics + lidar + truth_pose stand-in + guidance, launch/docking.launch through
+scripts/run_scenario, record:=true): docking from 15 m ends in capture inside the envelope, and the run directory holds
+a closed bag with every topic, the report's figures, report.md and a complete summary.json."""
+import os
+import sys
+import unittest
+
+import rosbag
+import rostest
+
+from scenario_run import SCENARIOS, bag_info, passed, run_scenario
+
+TOPICS = ["/clock", "/truth/target/odom", "/truth/chaser/odom", "/truth/relative", "/lidar/points", "/lidar/range",
+          "/lidar/camera_info", "/pose/estimate", "/guidance/command", "/guidance/state", "/dynamics/applied_wrench",
+          "/tf", "/tf_static", "/run/outcome"]
+SUMMARY_KEYS = ["docked", "collision", "aborted", "contact", "sim_time_s", "wall_time_s", "real_time_factor",
+                "frames", "lost_frames", "methods", "delta_v_mps", "scenario", "seed"]
+CONTACT_KEYS = ["closing_speed_mps", "lateral_misalignment_m", "angular_misalignment_deg", "lateral_rate_mps",
+                "angular_rate_dps", "within_envelope"]
+
+
+class DockShort(unittest.TestCase):
+    def test_docks_and_leaves_a_complete_run_directory(self):
+        out, s = run_scenario(self, os.path.join(SCENARIOS, "dock_15m.yaml"), "rviz:=none", "pose_source:=truth")
+        for key in SUMMARY_KEYS:
+            self.assertIn(key, s)
+        self.assertTrue(s["docked"], "outcome %s: %s" % (s["outcome"], s["reason"]))
+        self.assertFalse(s["collision"])
+        self.assertFalse(s["aborted"])
+        c = s["contact"]
+        for key in CONTACT_KEYS:
+            self.assertIn(key, c)
+        self.assertTrue(c["within_envelope"], c)
+        self.assertTrue(0.05 <= c["closing_speed_mps"] <= 0.10, c)
+        self.assertLessEqual(c["lateral_misalignment_m"], 0.10)
+        self.assertLessEqual(c["angular_misalignment_deg"], 4.0)
+        # One estimate per lidar frame, none LOST (truth_pose without dropouts), every frame in the summary.
+        self.assertGreater(s["frames"], 500)
+        self.assertEqual(s["lost_frames"], 0)
+        self.assertEqual(s["methods"]["truth"]["frames"], s["frames"])
+        self.assertLess(s["methods"]["truth"]["pos_max_m"], 1e-6)  # no noise: the stand-in reports truth
+        self.assertGreater(s["delta_v_mps"], 0.0)
+        self.assertGreater(s["real_time_factor"], 1.0)
+        self.assertEqual(s["scenario"]["name"], "dock_15m")
+        self.assertEqual(s["seed"]["lidar"], 2)
+
+        info = bag_info(os.path.join(out, "run.bag"))  # rosbag info fails on a bag that was not closed
+        recorded = {t["topic"]: t["messages"] for t in info["topics"]}
+        for topic in TOPICS:
+            self.assertIn(topic, recorded)
+        self.assertGreaterEqual(recorded["/lidar/points"], s["frames"])
+        self.assertFalse(os.path.exists(os.path.join(out, "run.bag.active")))
+        with rosbag.Bag(os.path.join(out, "run.bag")) as bag:
+            for _, msg, _ in bag.read_messages(topics=["/lidar/points"]):
+                self.assertEqual((msg.width, msg.height), (128, 128))  # the scenario's lidar section reached it
+                break
+
+        for name in ["report.md", "summary.json", "run.json", "scenario.yaml", "fig4_relative_position.png",
+                     "fig5_orientation_error.png", "fig6_velocity_thrust.png", "pose_error_vs_range.png",
+                     "params/lidar.yaml", "params/guidance.yaml"]:
+            path = os.path.join(out, name)
+            self.assertTrue(os.path.exists(path) and os.path.getsize(path) > 0, name)
+        with open(os.path.join(out, "report.md")) as f:
+            self.assertIn("capture", f.read())
+        passed(out)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("ardsim_bringup", "dock_short", DockShort, sys.argv)
