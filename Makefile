@@ -1,5 +1,5 @@
 # ardsim: every target installs what it lacks first (Debian packages, as root), then does its work.
-#   make demo    install, build, run the demo scenario
+#   make demo    install, build, run the default docking scenario recorded and filmed into runs/<date-time>/
 #   make test    install, build, run every gtest and rostest (non-zero exit on any failure)
 #   make bench   install, build, run the Google Benchmark programs and print ratios
 SHELL := /bin/bash
@@ -21,7 +21,7 @@ test: build
 	@scripts/run-tests
 
 demo: build
-	@$(WITH_ENV) scripts/demo
+	@scripts/demo $(ARGS)
 
 bench: build
 	@$(WITH_ENV) scripts/bench

@@ -1,0 +1,44 @@
+#!/usr/bin/env python3
+"""PENDING (needs ardsim_pose): the default scenario and the off-axis scenario dock with the pose estimator in the
+loop: capture inside the envelope, no LOST frame, pose errors within the goals of the pose issues."""
+import os
+import sys
+import unittest
+
+import rostest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from scenario_run import ROOT, passed, run_scenario  # noqa: E402
+
+GOALS = {"icp": {"pos_rms_m": 0.05, "att_rms_deg": 0.1}, "pyramid": {"pos_rms_m": 0.02, "att_rms_deg": 0.2},
+         "ring": {"pos_rms_m": 0.02, "att_rms_deg": 0.2}}
+
+
+class DefaultDocks(unittest.TestCase):
+    def check(self, scenario):
+        out, s = run_scenario(self, os.path.join(ROOT, "scenarios", scenario), "rviz:=none", "record:=true",
+                              "pose_source:=estimator", timeout_s=3000)
+        self.assertTrue(s["docked"], "%s: %s" % (s["outcome"], s["reason"]))
+        self.assertTrue(s["contact"]["within_envelope"], s["contact"])
+        self.assertEqual(s["lost_frames"], 0)
+        self.assertNotIn("truth", s["methods"])
+        self.assertEqual(s["error_source"], "pose/error")
+        for method, m in s["methods"].items():
+            goal = GOALS.get(method)
+            self.assertIsNotNone(goal, "unexpected method " + method)
+            self.assertLessEqual(m["pos_rms_m"], goal["pos_rms_m"], "%s %s" % (method, m))
+            self.assertLessEqual(m["att_rms_deg"], goal["att_rms_deg"], "%s %s" % (method, m))
+            self.assertLessEqual(m["pos_max_m"], 3 * max(m["pos_rms_m"], 0.01), "%s: a breakdown frame" % method)
+        print("SUMMARY %s %s" % (scenario, {k: s[k] for k in ("contact", "methods", "delta_v_mps",
+                                                                "real_time_factor")}))
+        passed(out)
+
+    def test_default_scenario_docks(self):
+        self.check("iss_axis_100m.yaml")
+
+    def test_off_axis_scenario_docks(self):
+        self.check("iss_off_axis.yaml")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("ardsim_bringup", "default_docks", DefaultDocks, sys.argv)
