@@ -72,7 +72,7 @@ TEST(GravityEval, UnreadableFileAndBadArgumentsExitWith2) {
 TEST(Propagate, WritesOneRowPerSampleWithTheInitialRelativeState) {
   const std::string out = ::testing::TempDir() + "/drift.csv";
   const ToolRun r = run(std::string(PROPAGATE) + " " + SCENARIO_DIR +
-                    "/free_drift.yaml --duration 60 --every 10 --out " + out);
+                        "/free_drift.yaml --duration 60 --every 10 --out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream in(out);
   std::string header, line;
