@@ -2,35 +2,22 @@
 
 #include <algorithm>
 
+#include <tf2_eigen/tf2_eigen.h>
+
 namespace ardsim_description {
 
 geometry_msgs::TransformStamped toTransformStamped(const Eigen::Isometry3d& T_parent_child,
                                                    const std::string& parent, const std::string& child,
                                                    const ros::Time& stamp) {
-  geometry_msgs::TransformStamped msg;
+  geometry_msgs::TransformStamped msg = tf2::eigenToTransform(Eigen::Affine3d(T_parent_child.matrix()));
   msg.header.stamp = stamp;
   msg.header.frame_id = parent;
   msg.child_frame_id = child;
-  const Eigen::Vector3d& t = T_parent_child.translation();
-  msg.transform.translation.x = t.x();
-  msg.transform.translation.y = t.y();
-  msg.transform.translation.z = t.z();
-  const Eigen::Quaterniond q(T_parent_child.linear());
-  msg.transform.rotation.x = q.x();
-  msg.transform.rotation.y = q.y();
-  msg.transform.rotation.z = q.z();
-  msg.transform.rotation.w = q.w();
   return msg;
 }
 
 Eigen::Isometry3d toIsometry(const geometry_msgs::Transform& transform) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() =
-      Eigen::Vector3d(transform.translation.x, transform.translation.y, transform.translation.z);
-  const Eigen::Quaterniond q(transform.rotation.w, transform.rotation.x, transform.rotation.y,
-                             transform.rotation.z);
-  T.linear() = q.normalized().toRotationMatrix();
-  return T;
+  return tf2::transformToEigen(transform);
 }
 
 visualization_msgs::Marker toMarker(const TriangleMesh& mesh, const std::string& frame_id,

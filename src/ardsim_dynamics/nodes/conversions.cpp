@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <tf2_eigen/tf2_eigen.h>
+
 namespace ardsim_dynamics {
 namespace {
 
@@ -49,16 +51,10 @@ void toOdometry(const RelativeState& s, const ros::Time& stamp, const std::strin
 
 geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& T, const ros::Time& stamp,
                                             const std::string& parent, const std::string& child) {
-  geometry_msgs::TransformStamped msg;
+  geometry_msgs::TransformStamped msg = tf2::eigenToTransform(Eigen::Affine3d(T.matrix()));
   msg.header.stamp = stamp;
   msg.header.frame_id = parent;
   msg.child_frame_id = child;
-  setVector(T.translation(), msg.transform.translation);
-  const Eigen::Quaterniond q(T.linear());
-  msg.transform.rotation.w = q.w();
-  msg.transform.rotation.x = q.x();
-  msg.transform.rotation.y = q.y();
-  msg.transform.rotation.z = q.z();
   return msg;
 }
 

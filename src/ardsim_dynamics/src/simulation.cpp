@@ -54,8 +54,9 @@ InitialStates initialStates(const Scenario& s) {
         target_orbit, CartesianState{s.chaser_initial.position_m, s.chaser_initial.velocity_mps});
     T_eci_chaser = Eigen::Isometry3d::Identity();
     // Docking attitude relative to the target's attitude, then the offset.
-    const Eigen::Matrix3d R_target_chaser = T_target_port_.linear() * ardsim_description::T_port_port_docked().linear() *
-                                            R_offset * T_chaser_port().linear().transpose();
+    const Eigen::Matrix3d R_target_chaser = T_target_port_.linear() *
+                                            ardsim_description::T_port_port_docked().linear() * R_offset *
+                                            T_chaser_port().linear().transpose();
     T_eci_chaser.linear() = T_eci_target.linear() * R_target_chaser;
     T_eci_chaser.translation() = chaser.position_m;
     v_chaser = chaser.velocity_mps;

@@ -4,36 +4,9 @@
 
 #include <Eigen/LU>
 
-namespace ardsim_guidance {
+#include "ardsim_dynamics/orbit.h"
 
-Matrix6d cwStateTransition(double n, double t) {
-  const double s = std::sin(n * t), c = std::cos(n * t), nt = n * t;
-  Matrix6d phi = Matrix6d::Zero();
-  // x
-  phi(0, 0) = 1.0;
-  phi(0, 2) = 6.0 * (nt - s);
-  phi(0, 3) = (4.0 * s - 3.0 * nt) / n;
-  phi(0, 5) = 2.0 * (1.0 - c) / n;
-  // y
-  phi(1, 1) = c;
-  phi(1, 4) = s / n;
-  // z
-  phi(2, 2) = 4.0 - 3.0 * c;
-  phi(2, 3) = -2.0 * (1.0 - c) / n;
-  phi(2, 5) = s / n;
-  // vx
-  phi(3, 2) = 6.0 * n * (1.0 - c);
-  phi(3, 3) = 4.0 * c - 3.0;
-  phi(3, 5) = 2.0 * s;
-  // vy
-  phi(4, 1) = -n * s;
-  phi(4, 4) = c;
-  // vz
-  phi(5, 2) = 3.0 * n * s;
-  phi(5, 3) = -2.0 * s;
-  phi(5, 5) = c;
-  return phi;
-}
+namespace ardsim_guidance {
 
 Eigen::Vector3d cwAcceleration(double n, const Eigen::Vector3d& r, const Eigen::Vector3d& v) {
   return {2.0 * n * v.z(), -n * n * r.y(), 3.0 * n * n * r.z() - 2.0 * n * v.x()};
@@ -44,7 +17,7 @@ TwoImpulseTransfer cwTwoImpulse(double n, const Eigen::Vector3d& r0, const Eigen
                                 double transfer_time_s) {
   TwoImpulseTransfer out;
   if (!(transfer_time_s > 0.0)) return out;
-  const Matrix6d phi = cwStateTransition(n, transfer_time_s);
+  const Matrix6d phi = ardsim_dynamics::cwTransition(n, transfer_time_s);
   // In-plane (x, z) and out-of-plane (y) decouple; solved separately so that an out-of-plane singularity
   // (nT = pi k: y(T) = -/+ y0 whatever vy) does not prevent the in-plane transfer.
   Eigen::Matrix2d rr, rv, vr, vv;

@@ -1,4 +1,5 @@
 #include "ardsim_guidance/far_field.h"
+#include "ardsim_dynamics/orbit.h"
 
 #include <algorithm>
 #include <vector>
@@ -55,7 +56,7 @@ std::vector<Eigen::Vector3d> cwPath(double n, const Eigen::Vector3d& r0, const E
   x0 << r0, v0;
   for (int i = 0; i < samples; ++i) {
     const double t = duration * (samples > 1 ? static_cast<double>(i) / (samples - 1) : 1.0);
-    path.push_back((cwStateTransition(n, t) * x0).head<3>());
+    path.push_back((ardsim_dynamics::cwTransition(n, t) * x0).head<3>());
   }
   return path;
 }

@@ -16,24 +16,6 @@ Eigen::Isometry3d lidarTargetFromPortPose(const VehicleFrames& f, const Eigen::I
   return f.T_chaser_lidar.inverse() * f.T_chaser_port * T_tp_cp.inverse() * f.T_target_port.inverse();
 }
 
-Eigen::Matrix3d dockedChaserPortInTargetPort() {
-  return Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
-
-Eigen::Matrix3d inertialFromLvlh(const Eigen::Vector3d& r, const Eigen::Vector3d& v) {
-  const Eigen::Vector3d z = -r.normalized();
-  const Eigen::Vector3d y = -r.cross(v).normalized();
-  Eigen::Matrix3d R;
-  R.col(0) = y.cross(z);
-  R.col(1) = y;
-  R.col(2) = z;
-  return R;
-}
-
-Eigen::Vector3d lvlhAngularVelocity(const Eigen::Vector3d& r, const Eigen::Vector3d& v) {
-  return {0.0, -r.cross(v).norm() / r.squaredNorm(), 0.0};
-}
-
 Eigen::Vector3d attitudeError(const Eigen::Quaterniond& q_ref_actual,
                               const Eigen::Quaterniond& q_ref_desired) {
   Eigen::Quaterniond q_err = q_ref_desired.conjugate() * q_ref_actual;

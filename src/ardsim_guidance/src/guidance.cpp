@@ -1,4 +1,5 @@
 #include "ardsim_guidance/guidance.h"
+#include "ardsim_dynamics/orbit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -154,7 +155,7 @@ Eigen::Quaterniond Guidance::desiredAttitudeInLvlh() const {
       options_.attitude_mode == AttitudeMode::kAlignPort && have_target_attitude_ ? q_lvlh_target_
                                                                                   : q_nominal;
   const Eigen::Matrix3d R_lvlh_chaser = q_lvlh_target.toRotationMatrix() * frames_.T_target_port.linear() *
-                                        dockedChaserPortInTargetPort() *
+                                        ardsim_description::T_port_port_docked().linear() *
                                         frames_.T_chaser_port.linear().transpose();
   return Eigen::Quaterniond(R_lvlh_chaser).normalized();
 }
@@ -175,8 +176,8 @@ GuidanceOutput Guidance::step(const EstimateInput& estimate, const OwnState* own
     return out;
   }
   const OwnState own = addSensorNoise(*own_truth);
-  const Eigen::Matrix3d R_eci_lvlh = inertialFromLvlh(own.position_eci_m, own.velocity_eci_mps);
-  const Eigen::Vector3d omega_lvlh = lvlhAngularVelocity(own.position_eci_m, own.velocity_eci_mps);
+  const Eigen::Matrix3d R_eci_lvlh = ardsim_dynamics::R_eci_lvlh({own.position_eci_m, own.velocity_eci_mps});
+  const Eigen::Vector3d omega_lvlh = ardsim_dynamics::lvlhRate({own.position_eci_m, own.velocity_eci_mps});
   // Mean motion of the target's orbit, from the chaser's own (nearby, near-circular) orbit.
   const double n = -omega_lvlh.y();
   const Eigen::Matrix3d R_lvlh_chaser =

@@ -1,4 +1,5 @@
 #include "ardsim_guidance/relative_navigator.h"
+#include "ardsim_dynamics/orbit.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -22,7 +23,7 @@ void RelativeNavigator::predict(double dt, double n, const Eigen::Vector3d& offs
   time_s_ += dt;
   Vector6d x;
   x << position_ - offset, velocity_;
-  const Matrix6d phi = cwStateTransition(n, dt);
+  const Matrix6d phi = ardsim_dynamics::cwTransition(n, dt);
   x = phi * x;
   // The commanded acceleration over one short step: its CW coupling (order n dt) is negligible.
   x.head<3>() += 0.5 * dt * dt * accel + offset;

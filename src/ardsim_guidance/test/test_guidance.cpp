@@ -41,22 +41,13 @@ TEST(Geometry, EstimateToPortAndBackRoundTrips) {
 TEST(Geometry, DockedOnTheAxisTheTargetIsStraightAheadOfTheLidar) {
   const VehicleFrames frames = VehicleFrames::fromDescription(TargetKind::kIss);
   Eigen::Isometry3d T_tp_cp = Eigen::Isometry3d::Identity();
-  T_tp_cp.linear() = dockedChaserPortInTargetPort();
+  T_tp_cp.linear() = ardsim_description::T_port_port_docked().linear();
   T_tp_cp.translation() = Eigen::Vector3d(10.0, 0.0, 0.0);
   // The target port is on the boresight, 10 m + the lidar's 1 m set-back from the chaser port.
   const Eigen::Vector3d port_in_lidar =
       lidarTargetFromPortPose(frames, T_tp_cp) * frames.T_target_port.translation();
   EXPECT_NEAR(port_in_lidar.z(), 11.0, 1e-12);
   EXPECT_NEAR(port_in_lidar.head<2>().norm(), 0.0, 1e-12);
-}
-
-TEST(Geometry, LvlhFromACircularOrbit) {
-  const Eigen::Vector3d r(7e6, 0, 0), v(0, 7.5e3, 0);
-  const Eigen::Matrix3d R = inertialFromLvlh(r, v);
-  EXPECT_NEAR((R.col(0) - Eigen::Vector3d::UnitY()).norm(), 0.0, 1e-12);  // V-bar
-  EXPECT_NEAR((R.col(2) + Eigen::Vector3d::UnitX()).norm(), 0.0, 1e-12);  // R-bar: to the Earth
-  EXPECT_NEAR((R.col(1) + Eigen::Vector3d::UnitZ()).norm(), 0.0, 1e-12);  // H-bar = -orbit normal
-  EXPECT_NEAR(lvlhAngularVelocity(r, v).y(), -7.5e3 / 7e6, 1e-15);
 }
 
 TEST(Options, BadValuesNameTheParameterValueAndRange) {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <random>
 
+#include "ardsim_dynamics/orbit.h"
 #include "ardsim_guidance/relative_navigator.h"
 
 using namespace ardsim_guidance;
@@ -30,7 +31,7 @@ double velocityNoise(VelocitySource source, double sigma, int seed) {
   for (int k = 0; k < 3000; ++k) {
     if (k > 0) {
       nav.predict(dt, kN, offset, accel);
-      const Vector6d free = cwStateTransition(kN, dt) * truth;
+      const Vector6d free = ardsim_dynamics::cwTransition(kN, dt) * truth;
       truth = free;
       truth.head<3>() += 0.5 * dt * dt * accel;
       truth.tail<3>() += dt * accel;

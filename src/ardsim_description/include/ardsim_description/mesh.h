@@ -1,5 +1,5 @@
-// A triangle mesh with per-triangle material and part, the geometry exchanged between the description (which builds
-// it), the LIDAR renderer, the pose estimator's reference model, the contact shapes and rviz.
+// A triangle mesh with per-triangle material and part, the geometry exchanged between the description (which
+// builds it), the LIDAR renderer, the pose estimator's reference model, the contact shapes and rviz.
 #pragma once
 
 #include <cstdint>
@@ -22,8 +22,8 @@ struct Part {
 };
 
 struct TriangleMesh {
-  std::vector<Eigen::Vector3f> vertices;      // m, in the vehicle's body frame
-  std::vector<Eigen::Vector3i> triangles;     // vertex indices, counter-clockwise seen from outside
+  std::vector<Eigen::Vector3f> vertices;         // m, in the vehicle's body frame
+  std::vector<Eigen::Vector3i> triangles;        // vertex indices, counter-clockwise seen from outside
   std::vector<std::uint16_t> triangle_material;  // index into materials, one per triangle
   std::vector<std::uint16_t> triangle_part;      // index into parts, one per triangle
   std::vector<Material> materials;

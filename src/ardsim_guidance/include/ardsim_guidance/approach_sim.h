@@ -1,8 +1,10 @@
-// Offline closed-loop study of guidance, ROS-free: the target on a circular orbit holding its attitude in
-// LVLH, the chaser under point-mass two-body gravity (RK4) with the commanded force and torque (rigid body,
-// Euler's equations), and pose estimates made from the truth by TruthPoseGenerator (noise, dropouts). Used by
-// the tests and the approach_sim tool to measure contact conditions, delta-v and how estimate noise reaches
-// the thrust. It is not the dynamics node: no geopotential, drag, actuator model or contact shapes.
+// Offline closed-loop study of guidance, ROS-free: the truth dynamics of ardsim_dynamics (Simulation) with
+// the target on a circular orbit holding its attitude in LVLH, under point-mass gravity without drag or
+// gravity-gradient torque (so that only guidance and the estimate noise shape the result), the commanded
+// force and torque applied exactly (no actuator limits beyond guidance's own), and pose estimates made from
+// the truth by TruthPoseGenerator (noise, dropouts). Used by the tests and the approach_sim tool to measure
+// contact conditions, delta-v and how estimate noise reaches the thrust, without ROS. Contact = the port
+// reaching the port plane.
 #pragma once
 
 #include <string>
@@ -20,7 +22,7 @@ struct ApproachSimOptions {
   double orbit_radius_m = 6378136.3 + 415e3;  // ISS-like circular orbit
   Eigen::Vector3d start_port_position_m{100.0, 0.0,
                                         0.0};  // chaser port in target_port at t = 0, at rest in LVLH
-  Eigen::Vector3d start_attitude_error_rad{0.0, 0.0, 0.0};  // rotation vector applied to the docking attitude
+  Eigen::Vector3d start_attitude_error_rad{0.0, 0.0, 0.0};  // roll, pitch, yaw added to the docking attitude
   double max_time_s = 3000.0;
   int substeps = 10;  // integration steps per control period
 };

@@ -11,9 +11,6 @@ namespace ardsim_guidance {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-// Closed-form state transition matrix Phi(t) for mean motion n (rad/s).
-Matrix6d cwStateTransition(double mean_motion_rad_s, double t_s);
-
 // Relative acceleration of free (unforced) CW motion at state (r, v).
 Eigen::Vector3d cwAcceleration(double mean_motion_rad_s, const Eigen::Vector3d& r, const Eigen::Vector3d& v);
 

@@ -24,19 +24,6 @@ Eigen::Isometry3d chaserPortInTargetPort(const VehicleFrames& frames,
 Eigen::Isometry3d lidarTargetFromPortPose(const VehicleFrames& frames,
                                           const Eigen::Isometry3d& T_targetport_chaserport);
 
-// Attitude of the chaser port when docked: its x anti-parallel to the target port's x, z parallel (a half
-// turn about the target port's z).
-Eigen::Matrix3d dockedChaserPortInTargetPort();
-
-// NASA LVLH axes from an inertial position and velocity: z to the Earth centre, y against the orbit angular
-// momentum, x = y x z (along the velocity for a circular orbit). Returns R_inertial_lvlh (columns: LVLH
-// axes).
-Eigen::Matrix3d inertialFromLvlh(const Eigen::Vector3d& r_m, const Eigen::Vector3d& v_mps);
-
-// Angular velocity of the LVLH frame with respect to inertial space, in LVLH axes: (0, -|h|/r^2, 0) for h = r
-// x v.
-Eigen::Vector3d lvlhAngularVelocity(const Eigen::Vector3d& r_m, const Eigen::Vector3d& v_mps);
-
 // Direction and position of the approach: a point on the docking axis range_m out of the port, in
 // target_port.
 inline Eigen::Vector3d approachAxisPoint(double range_m) {

@@ -1,7 +1,7 @@
 // Wall-clock throttled logging for every ardsim node. rosconsole's *_THROTTLE macros compare against
-// ros::Time::now(), which under sim time starts at 0 with the last hit at 0: every message in the first `period`
-// seconds of simulation is silently dropped. Throttle on wall time instead (it only decides what is logged, never
-// a result).
+// ros::Time::now(), which under sim time starts at 0 with the last hit at 0: every message in the first
+// `period` seconds of simulation is silently dropped. Throttle on wall time instead (it only decides what is
+// logged, never a result).
 #pragma once
 
 #include <ros/console.h>
