@@ -38,6 +38,7 @@ class DockShort(unittest.TestCase):
         # One estimate per lidar frame, none LOST (truth_pose without dropouts), every frame in the summary.
         self.assertGreater(s["frames"], 500)
         self.assertEqual(s["lost_frames"], 0)
+        self.assertEqual(s["bag_frames"], s["frames"], "the recorder dropped estimates")
         self.assertEqual(s["methods"]["truth"]["frames"], s["frames"])
         self.assertLess(s["methods"]["truth"]["pos_max_m"], 1e-6)  # no noise: the stand-in reports truth
         self.assertGreater(s["delta_v_mps"], 0.0)
