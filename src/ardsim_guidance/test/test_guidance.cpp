@@ -13,6 +13,7 @@ namespace {
 
 void expectInsideEnvelope(const ApproachSimResult& r) {
   ASSERT_TRUE(r.contact) << phaseName(r.final_phase) << ": " << r.final_reason;
+  EXPECT_TRUE(r.captured) << r.contact_reason;
   EXPECT_GE(r.closing_speed_mps, 0.05);
   EXPECT_LE(r.closing_speed_mps, 0.10);
   EXPECT_LE(r.lateral_misalignment_m, 0.10);
