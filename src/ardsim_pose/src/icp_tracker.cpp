@@ -71,6 +71,8 @@ void validate(const IcpOptions& o) {
   require(fraction(o.degraded_coverage) && o.degraded_coverage >= o.lost_coverage, "icp/degraded_coverage",
           o.degraded_coverage, "lost_coverage .. 1");
   require(fraction(o.degraded_condition), "icp/degraded_condition", o.degraded_condition, "0 .. 1");
+  require(positive(o.confirm_translation_m), "icp/confirm_translation_m", o.confirm_translation_m, "> 0");
+  require(positive(o.confirm_rotation_rad), "icp/confirm_rotation_rad", o.confirm_rotation_rad, "> 0");
   require(positive(o.max_correction_m), "icp/max_correction_m", o.max_correction_m, "> 0");
   require(positive(o.max_correction_rad), "icp/max_correction_rad", o.max_correction_rad, "> 0");
 }
@@ -133,6 +135,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     acquiring_ = true;
     return result;
   };
+  if (cloud.points.empty()) return lost("empty frame: no points");
   if (cloud.width != intrinsics_.width || cloud.height != intrinsics_.height ||
       cloud.points.size() != static_cast<std::size_t>(cloud.width) * cloud.height) {
     std::ostringstream reason;
@@ -308,6 +311,12 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   if (result.fit_rms_m > options_.degraded_fit_rms_m) degraded.push_back(format("fit rms %.3f m", result.fit_rms_m));
   if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
   if (condition < options_.degraded_condition) degraded.push_back(format("poorly constrained (condition %.1e)", condition));
+  // Acquisition ends when a frame agrees with the one before (its prediction): a local minimum of a single frame
+  // is not reported as TRACKING.
+  if (degraded.empty() && acquiring &&
+      (correction_m > options_.confirm_translation_m || correction_rad > options_.confirm_rotation_rad))
+    degraded.push_back(format("acquiring: %.3f m / %.3f deg from the previous frame", correction_m,
+                              correction_rad * 180.0 / M_PI));
   if (degraded.empty()) {
     result.status = EstimateStatus::kTracking;
     acquiring_ = false;

@@ -71,9 +71,11 @@ Eigen::Isometry3d PoseEstimator::predict(double stamp_s) const {
   return T;
 }
 
-void PoseEstimator::updateVelocity(const Eigen::Isometry3d& T, double stamp_s) {
+void PoseEstimator::updateVelocity(const Eigen::Isometry3d& T, EstimateStatus status, double stamp_s) {
   const double dt = stamp_s - last_good_stamp_s;
-  if (!have_good_ || dt <= 0.0 || dt > options_.max_prediction_gap_s) {
+  // Only TRACKING estimates in a row: the jumps of an acquisition are no motion.
+  if (!have_good_ || !last_good_tracking_ || status != EstimateStatus::kTracking || dt <= 0.0 ||
+      dt > options_.max_prediction_gap_s) {
     velocity_valid_ = false;
     return;
   }
@@ -123,7 +125,8 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
   previous_ = out.result;
   have_previous_ = true;
   if (out.result.status != EstimateStatus::kLost) {
-    updateVelocity(out.result.T_lidar_target, cloud.stamp_s);
+    updateVelocity(out.result.T_lidar_target, out.result.status, cloud.stamp_s);
+    last_good_tracking_ = out.result.status == EstimateStatus::kTracking;
     last_good_ = out.result.T_lidar_target;
     last_good_stamp_s = cloud.stamp_s;
     have_good_ = true;

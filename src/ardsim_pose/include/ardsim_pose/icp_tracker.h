@@ -31,12 +31,14 @@ struct IcpOptions {
   // Scan points within the Tukey limit of the model. Low at long range, where the solar arrays (not in the
   // model) fill much of the view.
   double lost_inlier_fraction = 0.15;
-  double degraded_inlier_fraction = 0.25;
+  double degraded_inlier_fraction = 0.3;
   double lost_fit_rms_m = 0.15;            // RMS plane residual of the inliers
   double degraded_fit_rms_m = 0.05;
   double lost_coverage = 0.35;             // predicted-visible model cells that the scan confirms
   double degraded_coverage = 0.55;
   double degraded_condition = 1e-3;        // smallest / largest eigenvalue of the scaled normal equations
+  double confirm_translation_m = 0.05;    // acquiring: TRACKING once a frame moves less than this from the last
+  double confirm_rotation_rad = 0.0035;
   double max_correction_m = 1.5;           // when tracking: a larger jump from the prediction is a divergence
   double max_correction_rad = 0.1;
 };

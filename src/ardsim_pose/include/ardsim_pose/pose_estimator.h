@@ -66,7 +66,7 @@ class PoseEstimator {
   Eigen::Isometry3d predict(double stamp_s) const;
 
  private:
-  void updateVelocity(const Eigen::Isometry3d& T, double stamp_s);
+  void updateVelocity(const Eigen::Isometry3d& T, EstimateStatus status, double stamp_s);
   Eigen::Isometry3d medianOf(const std::deque<Eigen::Isometry3d>& poses) const;
 
   EstimatorOptions options_;
@@ -75,6 +75,7 @@ class PoseEstimator {
   Eigen::Isometry3d prior_ = Eigen::Isometry3d::Identity();
   bool have_good_ = false;  // a TRACKING or DEGRADED estimate since the prior
   Eigen::Isometry3d last_good_ = Eigen::Isometry3d::Identity();
+  bool last_good_tracking_ = false;
   double last_good_stamp_s = 0.0;
   Eigen::Vector3d velocity_mps_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity_radps_ = Eigen::Vector3d::Zero();
