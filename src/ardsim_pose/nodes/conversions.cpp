@@ -21,9 +21,10 @@ bool quaternionOk(const geometry_msgs::Quaternion& q, std::string* error) {
 
 Eigen::Isometry3d toIsometry(const geometry_msgs::Pose& pose) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(pose.orientation.w, pose.orientation.x, pose.orientation.y, pose.orientation.z)
-                   .normalized()
-                   .toRotationMatrix();
+  T.linear() =
+      Eigen::Quaterniond(pose.orientation.w, pose.orientation.x, pose.orientation.y, pose.orientation.z)
+          .normalized()
+          .toRotationMatrix();
   T.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
   return T;
 }

@@ -16,18 +16,20 @@
 
 namespace ardsim_pose {
 
-// Organized cloud from lidar/points (float32 x, y, z; intensity optional). Returns false and says why in *error
-// for a cloud that is not organized, lacks a field, has another type or too little data. An empty cloud (0
-// points) converts (to an empty frame).
+// Organized cloud from lidar/points (float32 x, y, z; intensity optional). Returns false and says why in
+// *error for a cloud that is not organized, lacks a field, has another type or too little data. An empty
+// cloud (0 points) converts (to an empty frame).
 bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, OrganizedCloud* cloud, std::string* error);
 
 ardsim_msgs::PoseEstimatePtr toPoseEstimate(const EstimatorOutput& output, const std_msgs::Header& header);
 
-geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& T_parent_child, const std_msgs::Header& header,
+geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& T_parent_child,
+                                            const std_msgs::Header& header,
                                             const std::string& child_frame_id);
 
 // Pose from an estimate. Returns false (and says why) for a non-finite value or a non-unit quaternion.
-bool poseFromEstimate(const ardsim_msgs::PoseEstimate& msg, Eigen::Isometry3d* T_lidar_target, std::string* error);
+bool poseFromEstimate(const ardsim_msgs::PoseEstimate& msg, Eigen::Isometry3d* T_lidar_target,
+                      std::string* error);
 
 // Body pose in eci from truth odometry. Returns false (and says why) for a non-finite value or a non-unit
 // quaternion.

@@ -1,6 +1,6 @@
-// pose_evaluator: publishes pose/error (estimate minus truth at the same stamp) for every pose/estimate. Truth
-// T_lidar_target comes from truth/target/odom and truth/chaser/odom (paired by exact stamp) with T_chaser_lidar.
-// Either side may arrive first: both wait in bounded buffers keyed by stamp. Evaluation only.
+// pose_evaluator: publishes pose/error (estimate minus truth at the same stamp) for every pose/estimate.
+// Truth T_lidar_target comes from truth/target/odom and truth/chaser/odom (paired by exact stamp) with
+// T_chaser_lidar. Either side may arrive first: both wait in bounded buffers keyed by stamp. Evaluation only.
 #include <map>
 #include <string>
 

@@ -96,26 +96,28 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   validated("", [&] { validate(c); });
 
   read(nh, "initial/source", &o.initial_source);
-  if (o.initial_source != "docking_axis" && o.initial_source != "parameters" && o.initial_source != "scenario")
+  if (o.initial_source != "docking_axis" && o.initial_source != "parameters" &&
+      o.initial_source != "scenario")
     throw std::invalid_argument("parameter initial/source = '" + o.initial_source +
                                 "' is not allowed: docking_axis, parameters or scenario");
   read(nh, "initial/port_distance_m", &o.initial_port_distance_m);
   if (!(std::isfinite(o.initial_port_distance_m) && o.initial_port_distance_m > 0.0))
-    throw std::invalid_argument("parameter initial/port_distance_m = " + std::to_string(o.initial_port_distance_m) +
-                                " is out of range: > 0");
+    throw std::invalid_argument("parameter initial/port_distance_m = " +
+                                std::to_string(o.initial_port_distance_m) + " is out of range: > 0");
   readVector(nh, "initial/position_m", &o.initial_position_m);
   readVector(nh, "initial/rpy_deg", &o.initial_rpy_deg);
   read(nh, "initial/scenario_file", &o.initial_scenario_file);
   if (o.initial_source == "scenario" && o.initial_scenario_file.empty())
-    throw std::invalid_argument("parameter initial/scenario_file is required when initial/source is scenario");
+    throw std::invalid_argument(
+        "parameter initial/scenario_file is required when initial/source is scenario");
   read(nh, "initial/perturb", &o.initial_perturb);
   read(nh, "initial/attitude_deg", &o.perturbation.attitude_deg);
   read(nh, "initial/range_fraction", &o.perturbation.range_fraction);
   read(nh, "initial/lateral_m", &o.perturbation.lateral_m);
   if (!(std::isfinite(o.perturbation.attitude_deg) && o.perturbation.attitude_deg >= 0.0 &&
         o.perturbation.attitude_deg <= 180.0))
-    throw std::invalid_argument("parameter initial/attitude_deg = " + std::to_string(o.perturbation.attitude_deg) +
-                                " is out of range: 0 .. 180");
+    throw std::invalid_argument("parameter initial/attitude_deg = " +
+                                std::to_string(o.perturbation.attitude_deg) + " is out of range: 0 .. 180");
   if (!(std::isfinite(o.perturbation.range_fraction) && o.perturbation.range_fraction >= 0.0 &&
         o.perturbation.range_fraction < 1.0))
     throw std::invalid_argument("parameter initial/range_fraction = " +
@@ -125,7 +127,8 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
                                 " is out of range: >= 0");
   read(nh, "initial/seed", &o.initial_seed);
   if (o.initial_seed < 0)
-    throw std::invalid_argument("parameter initial/seed = " + std::to_string(o.initial_seed) + " is out of range: >= 0");
+    throw std::invalid_argument("parameter initial/seed = " + std::to_string(o.initial_seed) +
+                                " is out of range: >= 0");
   return o;
 }
 
@@ -140,7 +143,8 @@ Eigen::Isometry3d initialEstimate(const PoseNodeOptions& o) {
     const ardsim_dynamics::Scenario scenario = ardsim_dynamics::loadScenario(o.initial_scenario_file);
     if (scenario.target_kind != o.config.target)
       throw std::invalid_argument("parameter initial/scenario_file: the scenario's target is " +
-                                  ardsim_description::targetKindName(scenario.target_kind) + ", parameter target is " +
+                                  ardsim_description::targetKindName(scenario.target_kind) +
+                                  ", parameter target is " +
                                   ardsim_description::targetKindName(o.config.target));
     T = initialFromScenario(scenario);
   }
@@ -182,7 +186,8 @@ void PoseDriver::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     output = estimator_->process(cloud_);
   }
   if (output.result.status == EstimateStatus::kLost)
-    ARDSIM_WARN_THROTTLE(5.0, "pose: LOST at t = %.6f: %s", msg->header.stamp.toSec(), output.result.reason.c_str());
+    ARDSIM_WARN_THROTTLE(5.0, "pose: LOST at t = %.6f: %s", msg->header.stamp.toSec(),
+                         output.result.reason.c_str());
   estimate_publisher_.publish(toPoseEstimate(output, header));
   if (options_.publish_tf && output.result.status != EstimateStatus::kLost)
     tf_broadcaster_.sendTransform(toTransform(output.result.T_lidar_target, header, options_.child_frame_id));

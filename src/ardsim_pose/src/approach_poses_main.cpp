@@ -1,6 +1,6 @@
-// approach_poses: writes the pose list of an approach along the docking axis for render_dataset: the chaser in
-// docking attitude, its port from --from to --to metres out of the target port in --frames steps, the lidar on
-// its port axis (the target port on the boresight). Errors: one line on stderr, exit status 2.
+// approach_poses: writes the pose list of an approach along the docking axis for render_dataset: the chaser
+// in docking attitude, its port from --from to --to metres out of the target port in --frames steps, the
+// lidar on its port axis (the target port on the boresight). Errors: one line on stderr, exit status 2.
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -12,7 +12,8 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: approach_poses --target iss|hubble --from M --to M --frames N > POSES.csv\n"
-    "Rows: x y z qx qy qz qw, T_lidar_target (render_dataset's pose list). --from/--to: chaser port distance\n"
+    "Rows: x y z qx qy qz qw, T_lidar_target (render_dataset's pose list). --from/--to: chaser port "
+    "distance\n"
     "from the target port, m (the lidar is 1 m behind the chaser port).";
 
 double number(const std::string& flag, const std::string& value) {
@@ -48,8 +49,8 @@ int run(int argc, char** argv) {
   if (target.empty() || !(from_m > 0.0) || !(to_m > 0.0) || frames < 1)
     throw std::invalid_argument("--target, --from > 0, --to > 0 and --frames >= 1 are required");
   const ardsim_description::TargetKind kind = ardsim_description::parseTargetKind(target);
-  std::printf("# x y z qx qy qz qw: T_lidar_target, %s docking axis, chaser port %g m -> %g m\n", target.c_str(),
-              from_m, to_m);
+  std::printf("# x y z qx qy qz qw: T_lidar_target, %s docking axis, chaser port %g m -> %g m\n",
+              target.c_str(), from_m, to_m);
   for (int k = 0; k < frames; ++k) {
     const double d = frames == 1 ? from_m : from_m + (to_m - from_m) * k / (frames - 1);
     const Eigen::Isometry3d T = ardsim_pose::dockingAxisPose(kind, d);

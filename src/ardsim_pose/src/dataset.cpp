@@ -22,7 +22,8 @@ std::vector<TruthRow> readTruth(const std::string& path) {
     TruthRow row;
     double x, y, z, qx, qy, qz, qw;
     if (!(fields >> row.frame >> x >> y >> z >> qx >> qy >> qz >> qw))
-      throw std::runtime_error(path + ":" + std::to_string(line_number) + ": expected frame x y z qx qy qz qw");
+      throw std::runtime_error(path + ":" + std::to_string(line_number) +
+                               ": expected frame x y z qx qy qz qw");
     const Eigen::Quaterniond q(qw, qx, qy, qz);
     if (!(std::abs(q.norm() - 1.0) < 1e-3))
       throw std::runtime_error(path + ":" + std::to_string(line_number) + ": quaternion is not of unit norm");

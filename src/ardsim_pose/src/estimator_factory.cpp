@@ -29,7 +29,8 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config) {
   return makeEstimator(config, buildReferenceModel(config.target, config.model));
 }
 
-std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config, std::shared_ptr<const ReferenceModel> model) {
+std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
+                                             std::shared_ptr<const ReferenceModel> model) {
   validate(config);
   PoseEstimator::Methods methods;
   methods[EstimateMethod::kIcp] = std::make_unique<IcpTracker>(

@@ -32,7 +32,8 @@ struct Arguments {
 };
 
 std::string onOff(const std::string& flag, const std::string& value) {
-  if (value != "on" && value != "off") throw std::invalid_argument(flag + " '" + value + "' is not on or off");
+  if (value != "on" && value != "off")
+    throw std::invalid_argument(flag + " '" + value + "' is not on or off");
   return value;
 }
 
@@ -87,7 +88,9 @@ double rms(const std::vector<double>& v) {
   for (double x : v) sum += x * x;
   return v.empty() ? 0.0 : std::sqrt(sum / v.size());
 }
-double maxOf(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
+double maxOf(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+}
 double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -120,7 +123,7 @@ int run(int argc, char** argv) {
   csv << "frame,stamp_s,status,x,y,z,qx,qy,qz,qw,range_m,pos_err_m,att_err_deg,fit_rms_m,inlier_fraction,"
          "points_used,iterations,ms,reason\n";
   csv.precision(10);
-  std::vector<Band> bands = {{0, 10, {}, {}, {}},  {10, 20, {}, {}, {}},  {20, 30, {}, {}, {}},
+  std::vector<Band> bands = {{0, 10, {}, {}, {}},  {10, 20, {}, {}, {}}, {20, 30, {}, {}, {}},
                              {30, 50, {}, {}, {}}, {50, 75, {}, {}, {}}, {75, 1e9, {}, {}, {}}};
   Band all{0, 1e9, {}, {}, {}};
   for (std::size_t k = 0; k < truth.size(); ++k) {
@@ -153,8 +156,8 @@ int run(int argc, char** argv) {
         << out.result.inlier_fraction << ',' << out.result.points_used << ',' << out.result.iterations << ','
         << out.compute_ms << ",\"" << out.result.reason << "\"\n";
   }
-  std::printf("%-12s %6s %5s %10s %10s %11s %11s %8s\n", "range_m", "frames", "lost", "pos_rms_m", "pos_max_m",
-              "att_rms_deg", "att_max_deg", "ms_med");
+  std::printf("%-12s %6s %5s %10s %10s %11s %11s %8s\n", "range_m", "frames", "lost", "pos_rms_m",
+              "pos_max_m", "att_rms_deg", "att_max_deg", "ms_med");
   for (const Band& b : bands) {
     if (b.frames == 0) continue;
     char label[32];
@@ -165,8 +168,10 @@ int run(int argc, char** argv) {
     std::printf("%-12s %6d %5d %10.4f %10.4f %11.4f %11.4f %8.2f\n", label, b.frames, b.lost, rms(b.pos),
                 maxOf(b.pos), rms(b.att), maxOf(b.att), medianOf(b.ms));
   }
-  std::printf("summary frames=%d lost=%d pos_rms_m=%.4f pos_max_m=%.4f att_rms_deg=%.4f att_max_deg=%.4f ms_median=%.2f\n",
-              all.frames, all.lost, rms(all.pos), maxOf(all.pos), rms(all.att), maxOf(all.att), medianOf(all.ms));
+  std::printf(
+      "summary frames=%d lost=%d pos_rms_m=%.4f pos_max_m=%.4f att_rms_deg=%.4f att_max_deg=%.4f "
+      "ms_median=%.2f\n",
+      all.frames, all.lost, rms(all.pos), maxOf(all.pos), rms(all.att), maxOf(all.att), medianOf(all.ms));
   return 0;
 }
 

@@ -17,8 +17,12 @@ void require(bool ok, const std::string& name, double value, const std::string& 
   if (!ok) throw std::invalid_argument(name + " = " + std::to_string(value) + " is out of range: " + allowed);
 }
 
-bool positive(double v) { return std::isfinite(v) && v > 0.0; }
-bool fraction(double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; }
+bool positive(double v) {
+  return std::isfinite(v) && v > 0.0;
+}
+bool fraction(double v) {
+  return std::isfinite(v) && v >= 0.0 && v <= 1.0;
+}
 
 double median(std::vector<double>* values) {
   if (values->empty()) return 0.0;
@@ -54,19 +58,21 @@ void validate(const IcpOptions& o) {
           o.gate_acquisition_m, ">= gate_min_m");
   require(positive(o.tukey_c), "icp/tukey_c", o.tukey_c, "> 0");
   require(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
-  require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m, "> 0");
-  require(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad, "> 0");
-  require(positive(o.revisibility_translation_m), "icp/revisibility_translation_m", o.revisibility_translation_m,
+  require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
           "> 0");
+  require(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad, "> 0");
+  require(positive(o.revisibility_translation_m), "icp/revisibility_translation_m",
+          o.revisibility_translation_m, "> 0");
   require(positive(o.revisibility_rotation_rad), "icp/revisibility_rotation_rad", o.revisibility_rotation_rad,
           "> 0");
-  require(o.min_points >= 6 && o.min_points <= o.max_points, "icp/min_points", o.min_points, "6 .. max_points");
+  require(o.min_points >= 6 && o.min_points <= o.max_points, "icp/min_points", o.min_points,
+          "6 .. max_points");
   require(fraction(o.lost_inlier_fraction), "icp/lost_inlier_fraction", o.lost_inlier_fraction, "0 .. 1");
   require(fraction(o.degraded_inlier_fraction) && o.degraded_inlier_fraction >= o.lost_inlier_fraction,
           "icp/degraded_inlier_fraction", o.degraded_inlier_fraction, "lost_inlier_fraction .. 1");
   require(positive(o.lost_fit_rms_m), "icp/lost_fit_rms_m", o.lost_fit_rms_m, "> 0");
-  require(positive(o.degraded_fit_rms_m) && o.degraded_fit_rms_m <= o.lost_fit_rms_m, "icp/degraded_fit_rms_m",
-          o.degraded_fit_rms_m, "> 0 .. lost_fit_rms_m");
+  require(positive(o.degraded_fit_rms_m) && o.degraded_fit_rms_m <= o.lost_fit_rms_m,
+          "icp/degraded_fit_rms_m", o.degraded_fit_rms_m, "> 0 .. lost_fit_rms_m");
   require(fraction(o.lost_coverage), "icp/lost_coverage", o.lost_coverage, "0 .. 1");
   require(fraction(o.degraded_coverage) && o.degraded_coverage >= o.lost_coverage, "icp/degraded_coverage",
           o.degraded_coverage, "lost_coverage .. 1");
@@ -77,16 +83,21 @@ void validate(const IcpOptions& o) {
   require(positive(o.max_correction_rad), "icp/max_correction_rad", o.max_correction_rad, "> 0");
 }
 
-IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model, const ardsim_lidar::Intrinsics& intrinsics,
-                       const IcpOptions& options, const VisibilityOptions& visibility)
-    : model_(std::move(model)), intrinsics_(intrinsics), options_(options), visibility_(intrinsics, visibility) {
+IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model,
+                       const ardsim_lidar::Intrinsics& intrinsics, const IcpOptions& options,
+                       const VisibilityOptions& visibility)
+    : model_(std::move(model)),
+      intrinsics_(intrinsics),
+      options_(options),
+      visibility_(intrinsics, visibility) {
   validate(options_);
   if (!model_) throw std::invalid_argument("IcpTracker: no reference model");
 }
 
 double IcpTracker::coverage() const {
-  // Of the cells where the model is predicted (inside the image), the fraction where the scan has a return near
-  // the predicted depth: a different object, or the right object at a wrong pose, leaves most of them empty.
+  // Of the cells where the model is predicted (inside the image), the fraction where the scan has a return
+  // near the predicted depth: a different object, or the right object at a wrong pose, leaves most of them
+  // empty.
   const std::vector<float>& model_depth = visibility_.modelDepth();
   int predicted = 0;
   int confirmed = 0;
@@ -101,9 +112,9 @@ double IcpTracker::coverage() const {
 }
 
 void IcpTracker::alignRange(Eigen::Isometry3d* T) {
-  // A prior's range can be 10 % off: metres at 100 m, more than nearest-point correspondences can pull. Move the
-  // target along the line of sight by the ratio of the median scan depth to the median predicted model depth,
-  // over the cells where both are present (twice: the visible model changes with the range).
+  // A prior's range can be 10 % off: metres at 100 m, more than nearest-point correspondences can pull. Move
+  // the target along the line of sight by the ratio of the median scan depth to the median predicted model
+  // depth, over the cells where both are present (twice: the visible model changes with the range).
   for (int pass = 0; pass < 2; ++pass) {
     visibility_.predict(*model_, *T, &visible_);
     const std::vector<float>& model_depth = visibility_.modelDepth();
@@ -173,7 +184,8 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   Eigen::Isometry3d T_visibility = T;
   visibility_.predict(*model_, T, &visible_);
   double gate = acquiring ? options_.gate_acquisition_m : options_.gate_tracking_m;
-  const int max_iterations = acquiring ? options_.max_iterations_acquisition : options_.max_iterations_tracking;
+  const int max_iterations =
+      acquiring ? options_.max_iterations_acquisition : options_.max_iterations_tracking;
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   double sigma = options_.min_sigma_m;
@@ -212,8 +224,8 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     }
     if (!acquiring) active_.resize(kept);
     if (static_cast<int>(correspondences_.size()) < options_.min_points)
-      return lost("too few correspondences with the model: " + std::to_string(correspondences_.size()) + " < " +
-                  std::to_string(options_.min_points));
+      return lost("too few correspondences with the model: " + std::to_string(correspondences_.size()) +
+                  " < " + std::to_string(options_.min_points));
 
     scratch_.clear();
     for (const Correspondence& c : correspondences_) scratch_.push_back(std::abs(c.residual));
@@ -246,7 +258,8 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
       weighted_sq_sum += w * c.residual * c.residual;
     }
     if (inliers < options_.min_points)
-      return lost("too few inliers: " + std::to_string(inliers) + " < " + std::to_string(options_.min_points));
+      return lost("too few inliers: " + std::to_string(inliers) + " < " +
+                  std::to_string(options_.min_points));
     const Eigen::Matrix<double, 6, 1> delta = H.ldlt().solve(g);
     if (!delta.allFinite()) return lost("diverged: singular normal equations");
     const Eigen::Vector3d v = delta.head<3>();
@@ -288,7 +301,8 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   const double largest = eigen.eigenvalues()(5);
   const double condition = largest > 0.0 ? eigen.eigenvalues()(0) / largest : 0.0;
   // Information about the boresight rotation once the other five are free.
-  const Eigen::Matrix<double, 6, 6> scaled_inverse = H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  const Eigen::Matrix<double, 6, 6> scaled_inverse =
+      H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
   result.boresight_rotation_observed =
       largest > 0.0 && 1.0 / scaled_inverse(5, 5) / largest > options_.degraded_condition;
 
@@ -297,10 +311,13 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   const double correction_m = (T.translation() - T_predicted.translation()).norm();
   const double correction_rad = Eigen::AngleAxisd(correction.linear()).angle();
   std::vector<std::string> degraded;
-  if (!acquiring && (correction_m > options_.max_correction_m || correction_rad > options_.max_correction_rad))
-    return lost(format("diverged: %.2f m / %.2f deg from the prediction", correction_m, correction_rad * 180.0 / M_PI));
+  if (!acquiring &&
+      (correction_m > options_.max_correction_m || correction_rad > options_.max_correction_rad))
+    return lost(format("diverged: %.2f m / %.2f deg from the prediction", correction_m,
+                       correction_rad * 180.0 / M_PI));
   if (result.inlier_fraction < options_.lost_inlier_fraction)
-    return lost(format("poor fit: inlier fraction %.2f < %.2f", result.inlier_fraction, options_.lost_inlier_fraction));
+    return lost(format("poor fit: inlier fraction %.2f < %.2f", result.inlier_fraction,
+                       options_.lost_inlier_fraction));
   if (result.fit_rms_m > options_.lost_fit_rms_m)
     return lost(format("poor fit: rms %.3f m > %.3f m", result.fit_rms_m, options_.lost_fit_rms_m));
   if (coverage_ < options_.lost_coverage)
@@ -308,11 +325,13 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   if (!converged) degraded.push_back("not converged in " + std::to_string(iteration) + " iterations");
   if (result.inlier_fraction < options_.degraded_inlier_fraction)
     degraded.push_back(format("inlier fraction %.2f", result.inlier_fraction));
-  if (result.fit_rms_m > options_.degraded_fit_rms_m) degraded.push_back(format("fit rms %.3f m", result.fit_rms_m));
+  if (result.fit_rms_m > options_.degraded_fit_rms_m)
+    degraded.push_back(format("fit rms %.3f m", result.fit_rms_m));
   if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
-  if (condition < options_.degraded_condition) degraded.push_back(format("poorly constrained (condition %.1e)", condition));
-  // Acquisition ends when a frame agrees with the one before (its prediction): a local minimum of a single frame
-  // is not reported as TRACKING.
+  if (condition < options_.degraded_condition)
+    degraded.push_back(format("poorly constrained (condition %.1e)", condition));
+  // Acquisition ends when a frame agrees with the one before (its prediction): a local minimum of a single
+  // frame is not reported as TRACKING.
   if (degraded.empty() && acquiring &&
       (correction_m > options_.confirm_translation_m || correction_rad > options_.confirm_rotation_rad))
     degraded.push_back(format("acquiring: %.3f m / %.3f deg from the previous frame", correction_m,

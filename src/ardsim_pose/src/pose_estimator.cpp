@@ -141,7 +141,8 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
   out.velocity_mps = velocity_mps_;
   out.angular_velocity_radps = angular_velocity_radps_;
   out.velocity_valid = velocity_valid_ && out.result.status != EstimateStatus::kLost;
-  out.compute_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  out.compute_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 

@@ -41,14 +41,15 @@ void sampleTriangle(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Ei
 void validate(const ReferenceModelOptions& o) {
   require(std::isfinite(o.spacing_at_port_m) && o.spacing_at_port_m >= 0.005 && o.spacing_at_port_m <= 1.0,
           "model/spacing_at_port_m", o.spacing_at_port_m, "0.005 .. 1");
-  require(std::isfinite(o.spacing_growth_per_m) && o.spacing_growth_per_m >= 0.0 && o.spacing_growth_per_m <= 0.1,
-          "model/spacing_growth_per_m", o.spacing_growth_per_m, "0 .. 0.1");
+  require(
+      std::isfinite(o.spacing_growth_per_m) && o.spacing_growth_per_m >= 0.0 && o.spacing_growth_per_m <= 0.1,
+      "model/spacing_growth_per_m", o.spacing_growth_per_m, "0 .. 0.1");
   require(std::isfinite(o.max_spacing_m) && o.max_spacing_m >= o.spacing_at_port_m && o.max_spacing_m <= 2.0,
           "model/max_spacing_m", o.max_spacing_m, "spacing_at_port_m .. 2");
   require(std::isfinite(o.patch_spacings) && o.patch_spacings >= 1.0 && o.patch_spacings <= 20.0,
           "model/patch_spacings", o.patch_spacings, "1 .. 20");
-  require(std::isfinite(o.chunk_size_m) && o.chunk_size_m >= 0.5 && o.chunk_size_m <= 50.0, "model/chunk_size_m",
-          o.chunk_size_m, "0.5 .. 50");
+  require(std::isfinite(o.chunk_size_m) && o.chunk_size_m >= 0.5 && o.chunk_size_m <= 50.0,
+          "model/chunk_size_m", o.chunk_size_m, "0.5 .. 50");
 }
 
 void validate(const VisibilityOptions& o) {
@@ -82,8 +83,8 @@ struct ReferenceModel::KdTree {
 
 namespace {
 
-// nanoflann result set keeping the nearest point that the visibility mask lets through: the model is cropped by
-// index, the tree is never rebuilt.
+// nanoflann result set keeping the nearest point that the visibility mask lets through: the model is cropped
+// by index, the tree is never rebuilt.
 struct NearestVisibleResult {
   const std::uint8_t* visible;
   float best_distance_sq;
@@ -101,8 +102,8 @@ struct NearestVisibleResult {
 
 }  // namespace
 
-ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh, const Eigen::Isometry3d& T_target_port,
-                               const ReferenceModelOptions& options) {
+ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
+                               const Eigen::Isometry3d& T_target_port, const ReferenceModelOptions& options) {
   validate(options);
   const Eigen::Vector3f port = T_target_port.translation().cast<float>();
   std::vector<Eigen::Vector3f> points;
@@ -120,8 +121,9 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh, con
     if (!(area > 1e-10f)) continue;
     const Eigen::Vector3f normal = cross.normalized();
     const Eigen::Vector3f centroid = (a + b + c) / 3.0f;
-    const double s = std::min(options.max_spacing_m,
-                              options.spacing_at_port_m + options.spacing_growth_per_m * (centroid - port).norm());
+    const double s =
+        std::min(options.max_spacing_m,
+                 options.spacing_at_port_m + options.spacing_growth_per_m * (centroid - port).norm());
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
     // Enough points for the area, and for the length of long thin triangles (truss members).
     const int count = std::max(1, static_cast<int>(std::ceil(std::max(area / (s * s), longest / s))));
@@ -136,8 +138,8 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh, con
   }
   if (points.empty()) throw std::invalid_argument("reference model: the mesh has no triangles with area");
 
-  // Group the samples into patches (one triangle, a cube of patch_spacings spacings), the patches into chunks,
-  // and store the points patch by patch, the patches chunk by chunk.
+  // Group the samples into patches (one triangle, a cube of patch_spacings spacings), the patches into
+  // chunks, and store the points patch by patch, the patches chunk by chunk.
   std::map<std::tuple<std::uint32_t, int, int, int>, std::vector<std::uint32_t>> patch_members;
   for (std::uint32_t i = 0; i < points.size(); ++i) {
     const float size = static_cast<float>(options.patch_spacings) * spacing[i];
@@ -197,7 +199,8 @@ int ReferenceModel::nearestVisible(const Eigen::Vector3f& query, float max_dista
   return static_cast<int>(result.best_index);
 }
 
-VisibilityPredictor::VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options)
+VisibilityPredictor::VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics,
+                                         const VisibilityOptions& options)
     : intrinsics_(intrinsics), options_(options) {
   validate(options);
   grid_width_ = (intrinsics.width + options.cell_px - 1) / options.cell_px;
@@ -226,10 +229,9 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
   // Frustum side planes (with the margin) as unit normals pointing inside, for the chunk sphere test.
   const float tan_x = (cx + 0.5f + margin) / fx;
   const float tan_y = (cy + 0.5f + margin) / fy;
-  const Eigen::Vector3f planes[4] = {Eigen::Vector3f(1, 0, tan_x).normalized(),
-                                     Eigen::Vector3f(-1, 0, tan_x).normalized(),
-                                     Eigen::Vector3f(0, 1, tan_y).normalized(),
-                                     Eigen::Vector3f(0, -1, tan_y).normalized()};
+  const Eigen::Vector3f planes[4] = {
+      Eigen::Vector3f(1, 0, tan_x).normalized(), Eigen::Vector3f(-1, 0, tan_x).normalized(),
+      Eigen::Vector3f(0, 1, tan_y).normalized(), Eigen::Vector3f(0, -1, tan_y).normalized()};
   const float offset = static_cast<float>(margin_cells_);
   for (const ReferenceModel::Chunk& chunk : model.chunks()) {
     const Eigen::Vector3f c = R * chunk.centre + t;
@@ -257,14 +259,16 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
           float& d = depth_[static_cast<std::size_t>(y) * padded_width_ + x];
           d = std::min(d, p.z());
         }
-      const int cell_index = std::clamp(cv, 0, padded_height_ - 1) * padded_width_ + std::clamp(cu, 0, padded_width_ - 1);
+      const int cell_index =
+          std::clamp(cv, 0, padded_height_ - 1) * padded_width_ + std::clamp(cu, 0, padded_width_ - 1);
       candidates_.push_back({i, cell_index, p.z() - patch.radius});
     }
   }
   int count = 0;
   for (const Candidate& candidate : candidates_) {
     // A surface inclined in a cell spans a depth range: allow a few cells' width besides the fixed tolerance.
-    const float tolerance = std::max(static_cast<float>(options_.depth_tolerance_m), 3.0f * cell * candidate.depth / fx);
+    const float tolerance =
+        std::max(static_cast<float>(options_.depth_tolerance_m), 3.0f * cell * candidate.depth / fx);
     if (candidate.depth <= depth_[candidate.cell] + tolerance) {
       const ReferenceModel::Patch& patch = model.patches()[candidate.patch];
       std::fill(visible->begin() + patch.begin, visible->begin() + patch.end, 1);

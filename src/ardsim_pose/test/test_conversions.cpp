@@ -67,7 +67,8 @@ TEST(PoseConversions, EstimateCarriesPoseStatusAndCovariance) {
   out.result.status = EstimateStatus::kDegraded;
   out.result.method = EstimateMethod::kIcp;
   out.result.reason = "fit rms";
-  out.result.T_lidar_target = Eigen::Translation3d(1, 2, 30) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY());
+  out.result.T_lidar_target =
+      Eigen::Translation3d(1, 2, 30) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY());
   out.result.covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-4;
   out.velocity_mps = Eigen::Vector3d(0, 0, -0.1);
   out.velocity_valid = true;

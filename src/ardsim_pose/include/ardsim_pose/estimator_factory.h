@@ -1,5 +1,6 @@
-// Builds the estimator of a configuration: the reference model of the target's rigid structure, the methods and
-// the method selector. Where the node, evaluate_dataset, the tests and the benchmark get theirs. ROS-free.
+// Builds the estimator of a configuration: the reference model of the target's rigid structure, the methods
+// and the method selector. Where the node, evaluate_dataset, the tests and the benchmark get theirs.
+// ROS-free.
 #pragma once
 
 #include <memory>
@@ -33,6 +34,7 @@ std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::Ta
 
 std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config);
 // The same with a model already built (it is shared, read-only, between estimators).
-std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config, std::shared_ptr<const ReferenceModel> model);
+std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
+                                             std::shared_ptr<const ReferenceModel> model);
 
 }  // namespace ardsim_pose

@@ -1,6 +1,6 @@
 // Model-based ICP tracking of T_lidar_target from one organized cloud: point-to-plane against the reference
-// model cropped to what the sensor can see from the predicted pose, Tukey-weighted residuals, quality checks that
-// say TRACKING, DEGRADED or LOST, and the covariance from the final normal equations. ROS-free.
+// model cropped to what the sensor can see from the predicted pose, Tukey-weighted residuals, quality checks
+// that say TRACKING, DEGRADED or LOST, and the covariance from the final normal equations. ROS-free.
 #pragma once
 
 #include <cstdint>
@@ -14,32 +14,32 @@
 namespace ardsim_pose {
 
 struct IcpOptions {
-  int max_points = 1000;                 // scan points per frame (evenly spread over the valid pixels)
-  int max_iterations_tracking = 15;      // per frame once tracking
-  int max_iterations_acquisition = 40;   // per frame while acquiring (from a prior or after LOST)
-  double gate_tracking_m = 0.5;          // first correspondence gate when tracking
-  double gate_acquisition_m = 3.0;       // first correspondence gate while acquiring
-  double gate_min_m = 0.3;               // the gate shrinks to 4 x the median correspondence distance, not below
-  double tukey_c = 4.685;                // Tukey biweight constant, in robust sigmas of the plane residuals
-  double min_sigma_m = 0.01;             // floor of the robust sigma (the sensor's range noise)
-  double converged_translation_m = 1e-4; // an update smaller than both ends the iterations
+  int max_points = 1000;                // scan points per frame (evenly spread over the valid pixels)
+  int max_iterations_tracking = 15;     // per frame once tracking
+  int max_iterations_acquisition = 40;  // per frame while acquiring (from a prior or after LOST)
+  double gate_tracking_m = 0.5;         // first correspondence gate when tracking
+  double gate_acquisition_m = 3.0;      // first correspondence gate while acquiring
+  double gate_min_m = 0.3;    // the gate shrinks to 4 x the median correspondence distance, not below
+  double tukey_c = 4.685;     // Tukey biweight constant, in robust sigmas of the plane residuals
+  double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
+  double converged_translation_m = 1e-4;  // an update smaller than both ends the iterations
   double converged_rotation_rad = 1e-5;
   double revisibility_translation_m = 0.3;  // recompute the visibility when the pose moved more than this
   double revisibility_rotation_rad = 0.02;
   // Quality: below the `lost_` limits the frame is LOST, below the `degraded_` ones DEGRADED.
-  int min_points = 50;                     // valid scan points, and correspondences
+  int min_points = 50;  // valid scan points, and correspondences
   // Scan points within the Tukey limit of the model. Low at long range, where the solar arrays (not in the
   // model) fill much of the view.
   double lost_inlier_fraction = 0.15;
   double degraded_inlier_fraction = 0.3;
-  double lost_fit_rms_m = 0.15;            // RMS plane residual of the inliers
+  double lost_fit_rms_m = 0.15;  // RMS plane residual of the inliers
   double degraded_fit_rms_m = 0.05;
-  double lost_coverage = 0.35;             // predicted-visible model cells that the scan confirms
+  double lost_coverage = 0.35;  // predicted-visible model cells that the scan confirms
   double degraded_coverage = 0.55;
-  double degraded_condition = 1e-3;        // smallest / largest eigenvalue of the scaled normal equations
-  double confirm_translation_m = 0.05;    // acquiring: TRACKING once a frame moves less than this from the last
+  double degraded_condition = 1e-3;     // smallest / largest eigenvalue of the scaled normal equations
+  double confirm_translation_m = 0.05;  // acquiring: TRACKING once a frame moves less than this from the last
   double confirm_rotation_rad = 0.0035;
-  double max_correction_m = 1.5;           // when tracking: a larger jump from the prediction is a divergence
+  double max_correction_m = 1.5;  // when tracking: a larger jump from the prediction is a divergence
   double max_correction_rad = 0.1;
 };
 
@@ -51,7 +51,8 @@ class IcpTracker : public PoseMethod {
   IcpTracker(std::shared_ptr<const ReferenceModel> model, const ardsim_lidar::Intrinsics& intrinsics,
              const IcpOptions& options = {}, const VisibilityOptions& visibility = {});
 
-  PoseResult estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_lidar_target_predicted) override;
+  PoseResult estimate(const OrganizedCloud& cloud,
+                      const Eigen::Isometry3d& T_lidar_target_predicted) override;
   // Back to acquisition: the next frame starts from its prediction with the wide gate and more iterations.
   void reset() override { acquiring_ = true; }
 

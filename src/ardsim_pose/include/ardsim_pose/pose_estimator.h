@@ -1,5 +1,5 @@
-// The estimator facade that the node and evaluate_dataset drive, one frame at a time: it predicts the pose from
-// the previous estimates, asks a MethodSelector which PoseMethod runs this frame (ICP only for now; the
+// The estimator facade that the node and evaluate_dataset drive, one frame at a time: it predicts the pose
+// from the previous estimates, asks a MethodSelector which PoseMethod runs this frame (ICP only for now; the
 // close-range mode manager is another selector over more methods), and follows the method with an optional
 // median filter and the relative velocity. ROS-free.
 #pragma once
@@ -41,13 +41,14 @@ class FixedMethodSelector : public MethodSelector {
 struct EstimatorOptions {
   bool median_filter = false;  // median of the last median_window estimates (as in the study): smoother, lags
   int median_window = 5;       // frames, odd
-  double velocity_smoothing = 0.5;  // weight of the new difference in the velocity's exponential smoothing, 0..1
+  double velocity_smoothing =
+      0.5;  // weight of the new difference in the velocity's exponential smoothing, 0..1
   double max_prediction_gap_s = 2.0;  // a longer gap since the last good estimate: predict without velocity
 };
 void validate(const EstimatorOptions& options);
 
 struct EstimatorOutput {
-  PoseResult result;  // after the median filter when it is on
+  PoseResult result;                                                 // after the median filter when it is on
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();            // target origin, in lidar_optical
   Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();  // in lidar_optical
   bool velocity_valid = false;

@@ -1,6 +1,7 @@
-// The ICP's a-priori model: the target's rigid structure (articulated parts such as solar arrays and radiators
-// left out, they turn) sampled to points with their triangle's normal, a KD-tree over all of them built once, and
-// the per-frame visibility prediction that crops it to what the sensor can see from a pose. ROS-free.
+// The ICP's a-priori model: the target's rigid structure (articulated parts such as solar arrays and
+// radiators left out, they turn) sampled to points with their triangle's normal, a KD-tree over all of them
+// built once, and the per-frame visibility prediction that crops it to what the sensor can see from a pose.
+// ROS-free.
 #pragma once
 
 #include <cstdint>
@@ -15,13 +16,14 @@
 namespace ardsim_pose {
 
 struct ReferenceModelOptions {
-  // Sample spacing on the surfaces grows with the distance from the docking port: the port is seen from metres,
-  // the far structure only from tens of metres, where a pixel is as wide as the coarser spacing.
+  // Sample spacing on the surfaces grows with the distance from the docking port: the port is seen from
+  // metres, the far structure only from tens of metres, where a pixel is as wide as the coarser spacing.
   double spacing_at_port_m = 0.03;
   double spacing_growth_per_m = 0.004;  // spacing added per metre of distance from the port
   double max_spacing_m = 0.25;
-  double patch_spacings = 4.0;  // visibility is decided per patch: samples of one triangle within this many spacings
-  double chunk_size_m = 3.0;    // patches are culled against the view frustum in cubes of this size
+  double patch_spacings =
+      4.0;  // visibility is decided per patch: samples of one triangle within this many spacings
+  double chunk_size_m = 3.0;  // patches are culled against the view frustum in cubes of this size
 };
 
 // Throws std::invalid_argument naming the option, its value and the allowed range.
@@ -42,8 +44,8 @@ class ReferenceModel {
   const std::vector<float>& spacing() const { return spacing_; }            // m, per point
 
   // Nearest point with visible[index] != 0 within sqrt(max_distance_sq) of query (target frame); -1 if none.
-  int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq, const std::vector<std::uint8_t>& visible,
-                     float* distance_sq) const;
+  int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
+                     const std::vector<std::uint8_t>& visible, float* distance_sq) const;
 
   // Samples of one triangle close together: one visibility decision for all (points [begin, end)).
   struct Patch {
@@ -74,21 +76,23 @@ class ReferenceModel {
 };
 
 struct VisibilityOptions {
-  int cell_px = 4;                 // the depth buffer's cells are cell_px x cell_px sensor pixels
-  double margin_px = 12.0;         // points this far outside the image still count (the prediction is not exact)
-  double depth_tolerance_m = 0.2;  // a point within this (or 3 cells' width) behind the nearest surface is seen
+  int cell_px = 4;          // the depth buffer's cells are cell_px x cell_px sensor pixels
+  double margin_px = 12.0;  // points this far outside the image still count (the prediction is not exact)
+  double depth_tolerance_m =
+      0.2;  // a point within this (or 3 cells' width) behind the nearest surface is seen
 };
 void validate(const VisibilityOptions& options);
 
-// What the sensor can see of the model from a pose: front-facing patches inside the field of view (plus margin)
-// and not hidden by nearer structure, by a coarse depth buffer of splatted patches.
+// What the sensor can see of the model from a pose: front-facing patches inside the field of view (plus
+// margin) and not hidden by nearer structure, by a coarse depth buffer of splatted patches.
 class VisibilityPredictor {
  public:
   VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options);
 
   // Fills visible (one flag per model point) and the per-cell depth of the nearest predicted surface.
   // Returns the number of visible points.
-  int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target, std::vector<std::uint8_t>* visible);
+  int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
+              std::vector<std::uint8_t>* visible);
 
   int gridWidth() const { return grid_width_; }
   int gridHeight() const { return grid_height_; }
