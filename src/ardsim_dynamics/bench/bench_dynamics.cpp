@@ -1,7 +1,10 @@
 // Truth-dynamics throughput: the 13x13 field alone, one RK4 step of one vehicle with the full environment,
-// and one control step of the whole simulation (two vehicles). Goal (issue 2): at least 1e5 integration
-// steps/s on one core.
+// and one control step of the whole simulation (two vehicles), without and with the contact test (chaser far
+// from the ISS: bounding spheres only; near its port: Bullet's shape test every step). Goal (issue 2): at
+// least 1e5 integration steps/s on one core.
 #include <benchmark/benchmark.h>
+
+#include <memory>
 
 #include "ardsim_dynamics/simulation.h"
 
@@ -53,7 +56,8 @@ void BM_Rk4Step13x13_Ardsim(benchmark::State& state) {
 BENCHMARK(BM_Rk4Step13x13_Ardsim);
 
 void BM_SimulationControlStep_Ardsim(benchmark::State& state) {
-  Scenario scenario;  // defaults: ISS orbit, 13x13, one RK4 step per 0.1 s control step
+  Scenario scenario;                 // defaults: ISS orbit, 13x13, one RK4 step per 0.1 s control step
+  scenario.contact.enabled = false;  // the dynamics alone
   Simulation sim(scenario);
   BodyWrench command;
   command.force_n = Eigen::Vector3d(1.0, 0.0, 0.0);
@@ -63,6 +67,27 @@ void BM_SimulationControlStep_Ardsim(benchmark::State& state) {
       benchmark::Counter(state.iterations() * scenario.control_step_s, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_SimulationControlStep_Ardsim);
+
+// Arg 0: the chaser port 100 m out on the ISS docking axis (outside the bounding spheres); arg 1: 0.5 m from
+// the port, at rest relative to the ISS (inside them: the full shape test, no contact).
+void BM_SimulationControlStepContact_Ardsim(benchmark::State& state) {
+  Scenario scenario;
+  scenario.chaser_initial.frame = RelativeFrame::kTargetPort;
+  scenario.chaser_initial.position_m = Eigen::Vector3d(state.range(0) == 0 ? 100.0 : 0.5, 0.0, 0.0);
+  auto sim = std::make_unique<Simulation>(scenario);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(sim->step(BodyWrench{}));
+    if (sim->stepIndex() == 100) {
+      // Restart every 10 s of simulation so that the near chaser stays near (it drifts on its CW path).
+      state.PauseTiming();
+      sim = std::make_unique<Simulation>(scenario);
+      state.ResumeTiming();
+    }
+  }
+  if (sim->contact()) state.SkipWithError("unexpected contact");
+  state.counters["control_steps_per_s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_SimulationControlStepContact_Ardsim)->Arg(0)->Arg(1);
 
 }  // namespace
 

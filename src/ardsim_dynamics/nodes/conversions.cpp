@@ -73,6 +73,26 @@ bool fromWrench(const geometry_msgs::Wrench& msg, BodyWrench& w) {
   return true;
 }
 
+void toContactEvent(const ContactEvent& event, ardsim_msgs::ContactEvent& msg) {
+  msg.header.stamp = ros::Time(event.time_s);
+  msg.header.frame_id = "target_port";
+  msg.verdict = event.verdict == ContactVerdict::kCapture ? ardsim_msgs::ContactEvent::VERDICT_CAPTURE
+                                                          : ardsim_msgs::ContactEvent::VERDICT_COLLISION;
+  msg.reason = event.reason;
+  msg.target_part = event.target_part;
+  msg.chaser_part = event.chaser_part;
+  msg.contact_point.x = event.contact_point_m.x();
+  msg.contact_point.y = event.contact_point_m.y();
+  msg.contact_point.z = event.contact_point_m.z();
+  const ContactConditions& c = event.conditions;
+  msg.closing_speed_mps = c.closing_speed_mps;
+  msg.lateral_misalignment_m = c.lateral_misalignment_m;
+  msg.angular_misalignment_rad = c.angular_misalignment_rad;
+  msg.lateral_rate_mps = c.lateral_rate_mps;
+  msg.angular_rate_rad_s = c.angular_rate_radps;
+  msg.within_envelope = event.within_envelope;
+}
+
 VehicleState fromOdometry(const nav_msgs::Odometry& msg) {
   VehicleState s;
   const auto& p = msg.pose.pose.position;

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include <ardsim_msgs/ContactEvent.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Wrench.h>
 #include <nav_msgs/Odometry.h>
@@ -23,6 +24,8 @@ geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& T_parent_ch
 geometry_msgs::Wrench toWrench(const BodyWrench& wrench);
 // False (and nothing applied) when any component is not finite.
 bool fromWrench(const geometry_msgs::Wrench& msg, BodyWrench& wrench);
+// The first contact, stamped with its time, in target_port.
+void toContactEvent(const ContactEvent& event, ardsim_msgs::ContactEvent& msg);
 // Vehicle state back from odometry (the inverse of the first toOdometry).
 VehicleState fromOdometry(const nav_msgs::Odometry& msg);
 

@@ -4,9 +4,15 @@
 // (chaser_port in target_port), tf eci->{ecef, target_lvlh, target, chaser}; then waits for guidance/command
 // stamped t_k, applies it through the actuator model over [t_k, t_k + dt] (published on
 // dynamics/applied_wrench, stamped t_k) and advances.
+//
+// When the vehicles first touch inside a step (README.md "Contact"), the run ends there: the state at the
+// contact time is published like a step, then dynamics/contact (latched) with the conditions and the verdict,
+// and the node stops advancing.
+#include <ardsim_msgs/ContactEvent.h>
 #include <ardsim_msgs/log_throttle.h>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -80,6 +86,7 @@ class DynamicsNode {
     relative_pub_ = nh.advertise<nav_msgs::Odometry>("truth/relative", queue, true);
     applied_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("dynamics/applied_wrench", queue);
     tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", queue);
+    contact_pub_ = nh.advertise<ardsim_msgs::ContactEvent>("dynamics/contact", 1, true);
     if (!options_.free_run) {
       ros::SubscribeOptions so = ros::SubscribeOptions::create<geometry_msgs::WrenchStamped>(
           "guidance/command", 10,
@@ -103,6 +110,10 @@ class DynamicsNode {
       pace(wall_start);
       publishStep(stamp);
       ros::getGlobalCallbackQueue()->callAvailable();
+      if (sim_.contact()) {
+        publishContact(*sim_.contact());
+        break;
+      }
       if (sim_.stepIndex() >= last_step) break;
       BodyWrench command;
       if (!options_.free_run)
@@ -130,6 +141,28 @@ class DynamicsNode {
            chaser_pub_.getNumSubscribers() < static_cast<std::uint32_t>(options_.wait_for_subscribers) &&
            ros::WallTime::now() < deadline)
       ros::WallDuration(0.01).sleep();
+  }
+
+  void publishContact(const ContactEvent& event) {
+    auto msg = boost::make_shared<ardsim_msgs::ContactEvent>();
+    toContactEvent(event, *msg);
+    contact_pub_.publish(msg);
+    const ContactConditions& c = event.conditions;
+    char conditions[256];
+    std::snprintf(
+        conditions, sizeof(conditions),
+        "closing %.4f m/s, lateral %.4f m, angular %.2f deg, lateral rate %.4f m/s, angular rate %.4f deg/s",
+        c.closing_speed_mps, c.lateral_misalignment_m, c.angular_misalignment_rad * 180.0 / M_PI,
+        c.lateral_rate_mps, c.angular_rate_radps * 180.0 / M_PI);
+    char time[32];
+    std::snprintf(time, sizeof(time), "%.3f", event.time_s);
+    const std::string text = std::string("dynamics: ") + verdictName(event.verdict) + " at t = " + time +
+                             " s (chaser '" + event.chaser_part + "' on target '" + event.target_part +
+                             "'): " + event.reason + "; " + conditions + ". The run ends here.";
+    if (event.verdict == ContactVerdict::kCapture)
+      ROS_INFO("%s", text.c_str());
+    else
+      ROS_WARN("%s", text.c_str());
   }
 
   void pace(const ros::WallTime& wall_start) {
@@ -210,7 +243,7 @@ class DynamicsNode {
 
   DynamicsNodeOptions options_;
   Simulation& sim_;
-  ros::Publisher clock_pub_, target_pub_, chaser_pub_, relative_pub_, applied_pub_, tf_pub_;
+  ros::Publisher clock_pub_, target_pub_, chaser_pub_, relative_pub_, applied_pub_, tf_pub_, contact_pub_;
   ros::CallbackQueue command_queue_;
   ros::Subscriber command_sub_;
   ros::Time expected_stamp_;

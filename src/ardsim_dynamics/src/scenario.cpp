@@ -263,6 +263,22 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& source) 
     sim.fail("simulation.integration_step_s", std::to_string(s.integration_step_s),
              "a whole fraction of simulation.control_step_s (" + std::to_string(s.control_step_s) + ")");
 
+  MapReader contact = top.child("contact");
+  CaptureEnvelope& envelope = s.contact.envelope;
+  contact.boolean("enabled", s.contact.enabled);
+  contact.number("min_closing_speed_mps", envelope.min_closing_speed_mps, 0.0, 10.0);
+  contact.number("max_closing_speed_mps", envelope.max_closing_speed_mps, 0.0, 10.0);
+  contact.number("max_lateral_misalignment_m", envelope.max_lateral_misalignment_m, 0.0, 10.0);
+  contact.angleDeg("max_angular_misalignment_deg", envelope.max_angular_misalignment_rad, 0.0, 180.0);
+  contact.number("max_lateral_rate_mps", envelope.max_lateral_rate_mps, 0.0, 10.0);
+  contact.angleDeg("max_angular_rate_dps", envelope.max_angular_rate_radps, 0.0, 100.0);
+  contact.number("time_tolerance_s", s.contact.time_tolerance_s, 1e-6, 1.0);
+  contact.finish();
+  if (envelope.min_closing_speed_mps > envelope.max_closing_speed_mps)
+    contact.fail(
+        "contact.min_closing_speed_mps", std::to_string(envelope.min_closing_speed_mps),
+        "at most contact.max_closing_speed_mps (" + std::to_string(envelope.max_closing_speed_mps) + ")");
+
   const YAML::Node seeds = top.get("seeds");
   if (seeds.IsDefined() && !seeds.IsNull()) {
     if (!seeds.IsMap()) top.fail("seeds", describe(seeds), "a map of name: non-negative integer");

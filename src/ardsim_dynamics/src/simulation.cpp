@@ -1,6 +1,7 @@
 #include "ardsim_dynamics/simulation.h"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace ardsim_dynamics {
 namespace {
@@ -77,19 +78,71 @@ Simulation::Simulation(const Scenario& scenario)
   target_ = initial.target;
   chaser_ = initial.chaser;
   substeps_ = static_cast<int>(std::lround(scenario_.control_step_s / scenario_.integration_step_s));
+  if (scenario_.contact.enabled) {
+    contact_detector_ = std::make_unique<ContactDetector>(scenario_.target_kind);
+    const Touch touch = touchAt(target_, chaser_);
+    if (touch.touching)
+      contact_ =
+          judgeContact(0.0, touch, chaserPortInTargetPort(),
+                       ardsim_description::T_target_port(scenario_.target_kind), scenario_.contact.envelope);
+  }
 }
 
+Simulation::~Simulation() = default;
+
 BodyWrench Simulation::step(const BodyWrench& chaser_commanded) {
+  if (contact_) throw std::logic_error("Simulation::step: halted at the first contact");
   const BodyWrench applied = actuator_.apply(chaser_commanded, scenario_.control_step_s);
   const double h = scenario_.integration_step_s;
   const double t0 = time();
   for (int i = 0; i < substeps_; ++i) {
     const double t = t0 + i * h;
-    target_ = rk4Step(environment_, scenario_.target, target_, BodyWrench{}, t, h);
-    chaser_ = rk4Step(environment_, scenario_.chaser, chaser_, applied, t, h);
+    const VehicleState target0 = target_, chaser0 = chaser_;
+    target_ = rk4Step(environment_, scenario_.target, target0, BodyWrench{}, t, h);
+    chaser_ = rk4Step(environment_, scenario_.chaser, chaser0, applied, t, h);
+    if (!contact_detector_) continue;
+    const Touch touch = touchAt(target_, chaser_);
+    if (touch.touching) {
+      haltAtFirstContact(target0, chaser0, applied, t, touch);
+      return applied;
+    }
   }
   ++step_index_;
   return applied;
+}
+
+Touch Simulation::touchAt(const VehicleState& target, const VehicleState& chaser) const {
+  // From differences, so that the 7e6 m eci positions cancel before rounding matters.
+  const Eigen::Matrix3d R_eci_target = target.attitude.toRotationMatrix();
+  Eigen::Isometry3d T_target_chaser = Eigen::Isometry3d::Identity();
+  T_target_chaser.linear() = R_eci_target.transpose() * chaser.attitude.toRotationMatrix();
+  T_target_chaser.translation() = R_eci_target.transpose() * (chaser.position_m - target.position_m);
+  return contact_detector_->test(T_target_chaser);
+}
+
+void Simulation::haltAtFirstContact(const VehicleState& target0, const VehicleState& chaser0,
+                                    const BodyWrench& applied, double t_s, Touch touch) {
+  // Not touching at the step's start, touching at its end: bisect on the integrated states (each trial
+  // re-integrates the step from its start over the trial length, RK4 with the same wrench), assuming a single
+  // crossing within one integration step.
+  double lo_s = 0.0, hi_s = scenario_.integration_step_s;
+  while (hi_s - lo_s > scenario_.contact.time_tolerance_s) {
+    const double mid_s = 0.5 * (lo_s + hi_s);
+    const VehicleState target = rk4Step(environment_, scenario_.target, target0, BodyWrench{}, t_s, mid_s);
+    const VehicleState chaser = rk4Step(environment_, scenario_.chaser, chaser0, applied, t_s, mid_s);
+    const Touch trial = touchAt(target, chaser);
+    if (trial.touching) {
+      hi_s = mid_s;
+      target_ = target;
+      chaser_ = chaser;
+      touch = trial;
+    } else {
+      lo_s = mid_s;
+    }
+  }
+  contact_ =
+      judgeContact(t_s + hi_s, touch, chaserPortInTargetPort(),
+                   ardsim_description::T_target_port(scenario_.target_kind), scenario_.contact.envelope);
 }
 
 CartesianState Simulation::chaserInTargetLvlh() const {

@@ -48,3 +48,33 @@ TEST(Conversions, NonFiniteWrenchIsRejected) {
   EXPECT_FALSE(fromWrench(msg, untouched));
   EXPECT_EQ(untouched.torque_nm, Eigen::Vector3d::Zero());
 }
+
+TEST(Conversions, ContactEventCarriesConditionsAndVerdict) {
+  ContactEvent event;
+  event.time_s = 528.3125;
+  event.verdict = ContactVerdict::kCollision;
+  event.reason = "closing speed 0.300 m/s > 0.100 m/s";
+  event.target_part = "soft_capture_ring";
+  event.chaser_part = "guide_petals";
+  event.contact_point_m = Eigen::Vector3d(0.01, -0.4, 0.2);
+  event.conditions = {0.3, 0.02, 0.01, 0.003, 0.0004};
+  event.within_envelope = false;
+  ardsim_msgs::ContactEvent msg;
+  toContactEvent(event, msg);
+  EXPECT_DOUBLE_EQ(msg.header.stamp.toSec(), 528.3125);
+  EXPECT_EQ(msg.header.frame_id, "target_port");
+  EXPECT_EQ(msg.verdict, ardsim_msgs::ContactEvent::VERDICT_COLLISION);
+  EXPECT_EQ(msg.reason, event.reason);
+  EXPECT_EQ(msg.target_part, "soft_capture_ring");
+  EXPECT_EQ(msg.chaser_part, "guide_petals");
+  EXPECT_DOUBLE_EQ(msg.contact_point.y, -0.4);
+  EXPECT_DOUBLE_EQ(msg.closing_speed_mps, 0.3);
+  EXPECT_DOUBLE_EQ(msg.lateral_misalignment_m, 0.02);
+  EXPECT_DOUBLE_EQ(msg.angular_misalignment_rad, 0.01);
+  EXPECT_DOUBLE_EQ(msg.lateral_rate_mps, 0.003);
+  EXPECT_DOUBLE_EQ(msg.angular_rate_rad_s, 0.0004);
+  EXPECT_FALSE(msg.within_envelope);
+  event.verdict = ContactVerdict::kCapture;
+  toContactEvent(event, msg);
+  EXPECT_EQ(msg.verdict, ardsim_msgs::ContactEvent::VERDICT_CAPTURE);
+}

@@ -21,6 +21,13 @@ TruthPoseOptions loadOptions(const ros::NodeHandle& pnh, ardsim_description::Tar
   pnh.param("target", target_name, target_name);
   *target = ardsim_description::parseTargetKind(target_name);
   pnh.param("position_sigma_m", o.position_sigma_m, o.position_sigma_m);
+  std::vector<double> bias{0.0, 0.0, 0.0};
+  pnh.param("position_bias_m", bias, bias);
+  if (bias.size() != 3) {
+    throw std::invalid_argument("parameter 'position_bias_m' has " + std::to_string(bias.size()) +
+                                " elements; allowed: exactly 3");
+  }
+  o.position_bias_m = Eigen::Vector3d(bias[0], bias[1], bias[2]);
   double attitude_sigma_deg = 0.0;
   pnh.param("attitude_sigma_deg", attitude_sigma_deg, attitude_sigma_deg);
   o.attitude_sigma_rad = attitude_sigma_deg * M_PI / 180.0;

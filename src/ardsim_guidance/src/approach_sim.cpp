@@ -41,27 +41,14 @@ ApproachSimResult runApproachSim(const ApproachSimOptions& o) {
   Guidance guidance(g);
   TruthPoseGenerator truth_pose(o.truth_pose, frames);
   ardsim_dynamics::Simulation plant(plantScenario(o));
-  const Eigen::Matrix3d R_docked = ardsim_description::T_port_port_docked().linear();
 
   ApproachSimResult result;
   double sum_force_sq = 0.0;
   int force_samples = 0;
-  double prev_range = o.start_port_position_m.x();
-  while (plant.time() <= o.max_time_s) {
+  while (plant.time() <= o.max_time_s && !plant.contact()) {
     const double t = plant.time();
     const ardsim_dynamics::RelativeState port = plant.chaserPortInTargetPort();
     const Eigen::Vector3d& p_tp = port.pose.translation();
-    if (p_tp.x() <= 0.0 && prev_range > 0.0) {
-      result.contact = true;
-      result.time_s = t;
-      result.closing_speed_mps = -port.velocity_mps.x();
-      result.lateral_misalignment_m = p_tp.tail<2>().norm();
-      result.lateral_rate_mps = port.velocity_mps.tail<2>().norm();
-      result.angular_misalignment_rad = Eigen::AngleAxisd(R_docked.transpose() * port.pose.linear()).angle();
-      result.angular_rate_rad_s = port.angular_velocity_radps.norm();
-      break;
-    }
-    prev_range = p_tp.x();
     if (p_tp.x() <= g.near_field_range_m)
       result.max_corridor_ratio =
           std::max(result.max_corridor_ratio, p_tp.tail<2>().norm() / corridorRadius(g.safety, p_tp));
@@ -90,6 +77,17 @@ ApproachSimResult runApproachSim(const ApproachSimOptions& o) {
       ++force_samples;
     }
     plant.step(ardsim_dynamics::BodyWrench{command.force_body_n, command.torque_body_nm});
+  }
+  if (const auto& contact = plant.contact()) {
+    result.contact = true;
+    result.captured = contact->verdict == ardsim_dynamics::ContactVerdict::kCapture;
+    result.contact_reason = contact->reason;
+    result.time_s = contact->time_s;
+    result.closing_speed_mps = contact->conditions.closing_speed_mps;
+    result.lateral_misalignment_m = contact->conditions.lateral_misalignment_m;
+    result.lateral_rate_mps = contact->conditions.lateral_rate_mps;
+    result.angular_misalignment_rad = contact->conditions.angular_misalignment_rad;
+    result.angular_rate_rad_s = contact->conditions.angular_rate_radps;
   }
   result.rms_force_last_10m_n = force_samples > 0 ? std::sqrt(sum_force_sq / force_samples) : 0.0;
   return result;

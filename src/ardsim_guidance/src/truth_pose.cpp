@@ -14,6 +14,10 @@ void validate(const TruthPoseOptions& o) {
   };
   if (!(o.position_sigma_m >= 0.0 && std::isfinite(o.position_sigma_m)))
     fail("position_sigma_m", o.position_sigma_m, "[0, inf)");
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs(o.position_bias_m[i]) <= 100.0))
+      fail("position_bias_m[" + std::to_string(i) + "]", o.position_bias_m[i], "[-100, 100]");
+  }
   if (!(o.attitude_sigma_rad >= 0.0 && o.attitude_sigma_rad <= 0.5))
     fail("attitude_sigma_deg (rad)", o.attitude_sigma_rad, "[0, 0.5]");
   if (!(o.dropout_probability >= 0.0 && o.dropout_probability <= 1.0))
@@ -61,7 +65,7 @@ TruthPoseSample TruthPoseGenerator::generate(double t, const Eigen::Isometry3d& 
   if (rotation.norm() > 0.0) {
     T.linear() = Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix() * T.linear();
   }
-  T.translation() += dp * options_.position_sigma_m;
+  T.translation() += dp * options_.position_sigma_m + options_.position_bias_m;
   sample.T_lidar_target = T;
   last_good_ = T;
   return sample;

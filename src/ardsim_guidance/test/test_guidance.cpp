@@ -13,6 +13,7 @@ namespace {
 
 void expectInsideEnvelope(const ApproachSimResult& r) {
   ASSERT_TRUE(r.contact) << phaseName(r.final_phase) << ": " << r.final_reason;
+  EXPECT_TRUE(r.captured) << r.contact_reason;
   EXPECT_GE(r.closing_speed_mps, 0.05);
   EXPECT_LE(r.closing_speed_mps, 0.10);
   EXPECT_LE(r.lateral_misalignment_m, 0.10);
@@ -137,4 +138,22 @@ TEST(GuidanceClosedLoop, KalmanVelocityPutsLessNoiseIntoTheThrustThanDifferencin
   EXPECT_LT(kalman.rms_force_last_10m_n, differencing.rms_force_last_10m_n);
   // Measured (seed 11): Kalman 5.9 N, differencing 100 N.
   EXPECT_GT(differencing.rms_force_last_10m_n / kalman.rms_force_last_10m_n, 8.0);
+}
+
+TEST(TruthPose, PositionBiasIsAddedInTheLidarFrame) {
+  const VehicleFrames frames = VehicleFrames::fromDescription(TargetKind::kIss);
+  TruthPoseOptions unbiased, biased;
+  biased.position_bias_m = Eigen::Vector3d(0.5, -0.2, 0.1);
+  TruthPoseGenerator a(unbiased, frames), b(biased, frames);
+  Eigen::Isometry3d T_eci_target = Eigen::Isometry3d::Identity(),
+                    T_eci_chaser = Eigen::Isometry3d::Identity();
+  T_eci_chaser.translation() = Eigen::Vector3d(40.0, 1.0, 2.0);
+  const TruthPoseSample sa = a.generate(0.0, T_eci_target, T_eci_chaser);
+  const TruthPoseSample sb = b.generate(0.0, T_eci_target, T_eci_chaser);
+  EXPECT_LT(
+      (sb.T_lidar_target.translation() - sa.T_lidar_target.translation() - biased.position_bias_m).norm(),
+      1e-12);
+  EXPECT_TRUE(sb.T_lidar_target.linear().isApprox(sa.T_lidar_target.linear()));
+  biased.position_bias_m.y() = std::nan("");
+  EXPECT_THROW(validate(biased), std::invalid_argument);
 }

@@ -45,8 +45,11 @@ int main(int argc, char** argv) {
   o.max_time_s = num("max_time_s", 3000.0);
   try {
     const ApproachSimResult r = runApproachSim(o);
-    std::printf("contact %s at t = %.1f s, final phase %s (%s)\n", r.contact ? "yes" : "no", r.time_s,
-                phaseName(r.final_phase), r.final_reason.c_str());
+    std::printf("%s at t = %.1f s, final phase %s (%s)\n",
+                !r.contact   ? "no contact"
+                : r.captured ? "CAPTURE"
+                             : ("COLLISION: " + r.contact_reason).c_str(),
+                r.time_s, phaseName(r.final_phase), r.final_reason.c_str());
     std::printf(
         "closing speed %.4f m/s, lateral %.4f m, lateral rate %.4f m/s, angular misalignment %.3f deg, "
         "angular rate %.4f deg/s\n",

@@ -14,6 +14,7 @@
 
 #include "ardsim_description/frames.h"
 #include "ardsim_dynamics/actuator.h"
+#include "ardsim_dynamics/contact.h"
 #include "ardsim_dynamics/orbit.h"
 #include "ardsim_dynamics/vehicle_dynamics.h"
 
@@ -63,6 +64,7 @@ struct Scenario {
   ChaserInitialState chaser_initial;
   ActuatorOptions chaser_actuator;
   EnvironmentOptions environment;
+  ContactOptions contact;           // contact detection and the capture envelope
   std::string gravity_model_file;   // empty: the shipped EGM96 table
   double control_step_s = 0.1;      // one LIDAR frame, one guidance command
   double integration_step_s = 0.1;  // RK4 step; the control step must be a whole multiple of it

@@ -1,7 +1,8 @@
 // propagate SCENARIO.yaml [--duration S] [--every S] [--out FILE.csv]
 // Runs a scenario's truth dynamics without ROS or thrust and writes a CSV of both vehicles' eci states and
 // the chaser's state in the target's LVLH (and its port relative to the target port), for fast orbit
-// analysis.
+// analysis. A first contact between the vehicles ends the run: its last row is the contact state, and the
+// verdict goes to stderr.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -81,7 +82,8 @@ int main(int argc, char** argv) {
     ardsim_dynamics::Simulation sim(scenario);
     const long steps = std::lround(duration / scenario.control_step_s);
     for (long k = 0; k <= steps; ++k) {
-      if (k % stride == 0 || k == steps) {
+      const bool contact = sim.contact().has_value();
+      if (k % stride == 0 || k == steps || contact) {
         out << sim.time();
         writeVehicle(out, sim.target());
         writeVehicle(out, sim.chaser());
@@ -90,6 +92,11 @@ int main(int argc, char** argv) {
         out << ',' << rel.position_m.x() << ',' << rel.position_m.y() << ',' << rel.position_m.z() << ','
             << rel.velocity_mps.x() << ',' << rel.velocity_mps.y() << ',' << rel.velocity_mps.z() << ','
             << port.x() << ',' << port.y() << ',' << port.z() << '\n';
+      }
+      if (contact) {
+        std::cerr << "propagate: " << ardsim_dynamics::verdictName(sim.contact()->verdict)
+                  << " at t = " << sim.time() << " s: " << sim.contact()->reason << "\n";
+        break;
       }
       if (k < steps) sim.step(ardsim_dynamics::BodyWrench{});
     }

@@ -28,7 +28,9 @@ struct ApproachSimOptions {
 };
 
 struct ApproachSimResult {
-  bool contact = false;            // the chaser port reached the target port plane (range 0)
+  bool contact = false;            // the vehicles touched
+  bool captured = false;           // ... at the ports, inside the capture envelope
+  std::string contact_reason;      // why a contact is a collision
   double time_s = 0.0;             // time of contact or end of the run
   double closing_speed_mps = 0.0;  // at contact, truth
   double lateral_misalignment_m = 0.0;

@@ -16,7 +16,10 @@
 namespace ardsim_guidance {
 
 struct TruthPoseOptions {
-  double position_sigma_m = 0.0;     // 1-sigma noise per axis on T_lidar_target's translation (lidar_optical)
+  double position_sigma_m = 0.0;  // 1-sigma noise per axis on T_lidar_target's translation (lidar_optical)
+  // Constant error added to T_lidar_target's translation (lidar_optical): a biased estimator. Guidance trusts
+  // it, so a sideways bias aims the chaser beside the port (the collision test).
+  Eigen::Vector3d position_bias_m = Eigen::Vector3d::Zero();
   double attitude_sigma_rad = 0.0;   // 1-sigma noise per axis of a small rotation applied to T_lidar_target
   double dropout_probability = 0.0;  // chance that a frame is LOST at random
   std::vector<std::pair<double, double>>
