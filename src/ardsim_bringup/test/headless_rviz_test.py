@@ -11,9 +11,8 @@ import unittest
 import matplotlib.image
 import numpy as np
 import rostest
-import yaml
 
-from scenario_run import ROOT, SCENARIOS, passed, run_scenario
+from scenario_run import passed, run_scenario, scenario_variant
 
 
 def probe(path):
@@ -26,15 +25,7 @@ def probe(path):
 
 class HeadlessRviz(unittest.TestCase):
     def test_video_and_screenshots(self):
-        base = os.path.join(SCENARIOS, "dock_15m.yaml")
-        with open(base) as f:
-            scenario = yaml.safe_load(f)
-        scenario["name"] = "headless_30s"
-        scenario["run"]["time_limit_s"] = 30.0
-        short = os.path.join(ROOT, ".home", "headless_30s.yaml")
-        os.makedirs(os.path.dirname(short), exist_ok=True)
-        with open(short, "w") as f:
-            yaml.safe_dump(scenario, f)
+        short = scenario_variant("headless_30s", "dock_15m.yaml", time_limit_s=30.0)
         out, s = run_scenario(self, short, "rviz:=headless", "record:=false", "real_time_factor:=2",
                               "pose_source:=truth", "png_every_s:=3")
         self.assertEqual(s["outcome"], "time_limit")

@@ -28,6 +28,20 @@ def run_scenario(test, scenario, *args, timeout_s=900):
         return out, json.load(f)
 
 
+def scenario_variant(name, base, **run_section):
+    """A copy of test scenario `base` named `name` with keys of its `run` section replaced; returns its path."""
+    import yaml
+    with open(os.path.join(SCENARIOS, base)) as f:
+        scenario = yaml.safe_load(f)
+    scenario["name"] = name
+    scenario["run"].update(run_section)
+    path = os.path.join(ROOT, ".home", name + ".yaml")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        yaml.safe_dump(scenario, f)
+    return path
+
+
 def passed(out):
     """Call at the end of a test method: only reached when every assertion held."""
     shutil.rmtree(out, ignore_errors=True)
