@@ -104,7 +104,20 @@ AdapterFitter::AdapterFitter(const AdapterGeometry& geometry, const AdapterFitOp
 void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
                                      const Eigen::Isometry3d& T_lidar_port, double band) {
   const AdapterGeometry& g = geometry_;
+  const double face_x[kFaces] = {0.0, g.tunnel_face_x_m, g.hatch_face_x_m, g.plate_face_x_m,
+                                 g.cross_face_x_m};
+  // Radius windows (squared) of each face, a little inside its edges.
+  const auto sq = [](double x) { return x * x; };
+  const double ring_in = sq(g.ring_inner_radius_m + 0.01), ring_out = sq(g.ring_outer_radius_m - 0.01);
+  const double tunnel_in = sq(g.ring_outer_radius_m + 0.03), tunnel_out = sq(g.tunnel_outer_radius_m - 0.03);
+  const double hatch_in = sq(g.plate_radius_m + 0.03), hatch_out = sq(g.hatch_radius_m - 0.025);
+  const double plate_out = sq(g.plate_radius_m - 0.02);
+  // At the cross's depth inside the passage there is nothing but the cross: take it all, however far the
+  // guess's centre is off.
+  const double cross_out = sq(g.hatch_radius_m - 0.02);
   const Eigen::Isometry3d T_port_lidar = T_lidar_port.inverse();
+  const Eigen::Matrix3d R = T_port_lidar.linear();
+  const Eigen::Vector3d t = T_port_lidar.translation();
   const int n = frame.width * frame.height;
   plane_points_.clear();
   is_ring_.assign(n, 0);
@@ -113,66 +126,88 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
   for (int i = 0; i < n; ++i) {
     if (!frame.isValid(i)) continue;
     const Eigen::Vector3d p = frame.points[i].cast<double>();
-    const Eigen::Vector3d q = T_port_lidar * p;
-    const double r = std::hypot(q.y(), q.z());
+    const Eigen::Vector3d q = R * p + t;
+    const double r2 = q.y() * q.y() + q.z() * q.z();
     const bool off_cross = std::abs(q.y()) > 0.04 && std::abs(q.z()) > 0.04;
-    double face_x = std::numeric_limits<double>::quiet_NaN();
+    int face = -1;
     if (is_ring_[i]) {
-      face_x = 0.0;
-    } else if (ring_from_model && std::abs(q.x()) < band && r > g.ring_inner_radius_m + 0.01 &&
-               r < g.ring_outer_radius_m - 0.01) {
-      face_x = 0.0;
+      face = 0;
+    } else if (ring_from_model && std::abs(q.x()) < band && r2 > ring_in && r2 < ring_out) {
+      face = 0;
       is_ring_[i] = 1;
-    } else if (std::abs(q.x() - g.tunnel_face_x_m) < band && r > g.ring_outer_radius_m + 0.03 &&
-               r < g.tunnel_outer_radius_m - 0.03) {
-      face_x = g.tunnel_face_x_m;
-    } else if (std::abs(q.x() - g.hatch_face_x_m) < band && r > g.plate_radius_m + 0.03 &&
-               r < g.hatch_radius_m - 0.025 && off_cross) {
-      face_x = g.hatch_face_x_m;
-    } else if (std::abs(q.x() - g.plate_face_x_m) < band && r < g.plate_radius_m - 0.02 && off_cross) {
-      face_x = g.plate_face_x_m;
-    } else if (std::abs(q.x() - g.cross_face_x_m) < band && r < g.hatch_radius_m - 0.02) {
-      // At the cross's depth inside the passage there is nothing but the cross: take it all, however far the
-      // guess's centre is off.
-      face_x = g.cross_face_x_m;
+    } else if (std::abs(q.x() - face_x[1]) < band && r2 > tunnel_in && r2 < tunnel_out) {
+      face = 1;
+    } else if (std::abs(q.x() - face_x[2]) < band && r2 > hatch_in && r2 < hatch_out && off_cross) {
+      face = 2;
+    } else if (std::abs(q.x() - face_x[3]) < band && r2 < plate_out && off_cross) {
+      face = 3;
+    } else if (std::abs(q.x() - face_x[4]) < band && r2 < cross_out) {
+      face = 4;
     }
-    if (face_x == face_x) plane_points_.push_back({p, face_x, i});
+    if (face >= 0) plane_points_.push_back({p, face_x[face], face, i});
   }
 }
 
 bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* normal, double* offset,
                               double* rms, int* used) {
+  // Each face's points enter the least squares only through their sums (count, sum of p, sum of p p^T), so
+  // the Gauss-Newton steps cost nothing per point; the points are visited once per rejection scale: wide
+  // first (the seed may be off by centimetres), then a few sigma.
+  struct FaceSums {
+    double x = 0.0;  // the face's x in the port frame
+    double count = 0.0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  };
   Eigen::Vector3d n = *normal;
   double d = *offset;
   const double sigma = options_.range_sigma_m;
-  for (int iteration = 0; iteration < 4; ++iteration) {
-    // Tangent directions of the normal: n(delta) = n + delta1 t1 + delta2 t2.
-    const Eigen::Matrix3d R = portRotation(n, 0.0);
-    const Eigen::Vector3d t1 = R.col(1), t2 = R.col(2);
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
-    double sum_sq = 0.0, sum_w = 0.0;
+  const double rejects[3] = {2.0 * options_.plane_band_m, 4.0 * sigma, 3.0 * sigma};
+  for (double reject : rejects) {
+    std::array<FaceSums, kFaces> faces;
+    double sum_sq = 0.0;
     int inliers = 0;
-    // Robust scale: wide on the first pass (the seed may be off by centimetres), then a few sigma.
-    const double reject = iteration == 0 ? 2.0 * options_.plane_band_m : 4.0 * sigma;
     for (const PlanePoint& pp : points) {
       const double residual = n.dot(pp.p) - d - pp.face_x;
       if (std::abs(residual) > reject) continue;
-      const double huber = 2.0 * sigma;
-      const double w = std::abs(residual) < huber ? 1.0 : huber / std::abs(residual);
-      const Eigen::Vector3d J(t1.dot(pp.p), t2.dot(pp.p), -1.0);
-      A += w * J * J.transpose();
-      b -= w * J * residual;
-      sum_sq += w * residual * residual;
-      sum_w += w;
+      FaceSums& f = faces[pp.face];
+      f.x = pp.face_x;
+      f.count += 1.0;
+      f.sum += pp.p;
+      f.scatter.noalias() += pp.p * pp.p.transpose();
+      sum_sq += residual * residual;
       ++inliers;
     }
     if (inliers < options_.min_plane_points) return false;
-    const Eigen::Vector3d delta = A.ldlt().solve(b);
-    n = (n + delta(0) * t1 + delta(1) * t2).normalized();
-    d += delta(2);
-    *rms = std::sqrt(sum_sq / sum_w);
+    *rms = std::sqrt(sum_sq / inliers);
     *used = inliers;
+    for (int step = 0; step < 3; ++step) {
+      // Residual e = n.p - d - x of a face's point, Jacobian J = (t1.p, t2.p, -1) for n + a t1 + b t2, d + c.
+      const Eigen::Matrix3d R = portRotation(n, 0.0);
+      const Eigen::Vector3d t1 = R.col(1), t2 = R.col(2);
+      Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d b = Eigen::Vector3d::Zero();
+      for (const FaceSums& f : faces) {
+        if (f.count == 0.0) continue;
+        const double offset_f = d + f.x;
+        const Eigen::Vector3d Mt1 = f.scatter * t1, Mt2 = f.scatter * t2, Mn = f.scatter * n;
+        A(0, 0) += t1.dot(Mt1);
+        A(0, 1) += t1.dot(Mt2);
+        A(1, 1) += t2.dot(Mt2);
+        A(0, 2) -= t1.dot(f.sum);
+        A(1, 2) -= t2.dot(f.sum);
+        A(2, 2) += f.count;
+        b(0) -= t1.dot(Mn) - offset_f * t1.dot(f.sum);
+        b(1) -= t2.dot(Mn) - offset_f * t2.dot(f.sum);
+        b(2) += n.dot(f.sum) - offset_f * f.count;
+      }
+      A(1, 0) = A(0, 1);
+      A(2, 0) = A(0, 2);
+      A(2, 1) = A(1, 2);
+      const Eigen::Vector3d delta = A.ldlt().solve(b);
+      n = (n + delta(0) * t1 + delta(1) * t2).normalized();
+      d += delta(2);
+    }
   }
   *normal = n;
   *offset = d;
@@ -520,10 +555,10 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   for (int i = 0; i < pixels; ++i) {
     if (!frame.isValid(i)) continue;
     const Eigen::Vector3d q = T_port0_lidar * frame.points[i].cast<double>();
-    const double radius = std::hypot(q.y(), q.z());
-    const double angle = std::atan2(q.z(), q.y());
-    if (q.x() > on_plane && q.x() < g.petal_top_x_m + 0.02 && radius > g.petal_min_radius_m &&
-        radius < g.petal_max_radius_m) {
+    if (q.x() <= on_plane || q.x() >= g.petal_top_x_m + 0.02) continue;
+    const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
+    if (radius > g.petal_min_radius_m && radius < g.petal_max_radius_m) {
+      const double angle = std::atan2(q.z(), q.y());
       petal_points.push_back({angle, onBorder(frame, i)});
       petal_sum += std::polar(1.0, 3.0 * angle);
     }

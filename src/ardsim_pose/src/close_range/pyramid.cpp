@@ -44,7 +44,7 @@ void PyramidMethod::cellFeatures(const Eigen::Isometry3d& T_port_lidar, PyramidC
       s_p += p;
       s_pp += p * p.transpose();
       const Eigen::Vector3d q = T_port_lidar * p;
-      const double radius = std::hypot(q.y(), q.z());
+      const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
       if (std::abs(q.x()) < options_.ring_band_m &&
           radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
           radius < g.ring_outer_radius_m + options_.lateral_margin_m) {
@@ -149,7 +149,7 @@ PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
         const int i = v * frame_.width + u;
         if (!frame_.isValid(i)) continue;
         const Eigen::Vector3d q = T_port_lidar * frame_.points[i].cast<double>();
-        const double radius = std::hypot(q.y(), q.z());
+        const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
         if (std::abs(q.x()) < options_.ring_band_m &&
             radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
             radius < g.ring_outer_radius_m + options_.lateral_margin_m) {

@@ -34,7 +34,7 @@ bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& members, c
       scatter += p * p.transpose();
       n += 1.0;
     }
-    if (n < options.min_cluster_pixels) return false;
+    if (n * options.stride * options.stride < options.min_cluster_pixels) return false;
     mean = sum / n;
     eig.compute(scatter / n - mean * mean.transpose());
     normal = eig.eigenvectors().col(0);
@@ -147,50 +147,64 @@ bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& members, c
 void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, RingDetection* detection) {
   *detection = RingDetection();
   const int width = frame.width, height = frame.height, n = width * height;
+  // Clusters grow over every stride-th pixel in both directions (the ring is tens of pixels wide down to 7
+  // m); the ring's pixels are filled in at full resolution at the end.
+  const int stride = options.stride;
   std::vector<int> label(n, -1);
   std::vector<int> members;
-  members.reserve(n);
+  members.reserve(n / (stride * stride) + 1);
   int next_label = 0;
-  for (int seed = 0; seed < n; ++seed) {
-    if (label[seed] >= 0 || !frame.isValid(seed)) continue;
-    members.clear();
-    members.push_back(seed);
-    label[seed] = next_label;
-    for (std::size_t head = 0; head < members.size(); ++head) {
-      const int i = members[head];
-      const int u = i % width, v = i / width;
-      const float r = frame.range_m[i];
-      const float step = static_cast<float>(options.connect_step_m +
-                                            r * options.fit.pixel_pitch_rad * options.slope_allowance);
-      const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < width ? i + 1 : -1, v > 0 ? i - width : -1,
-                                 v + 1 < height ? i + width : -1};
-      for (int j : neighbours) {
-        if (j < 0 || label[j] >= 0 || !frame.isValid(j)) continue;
-        if (std::abs(frame.range_m[j] - r) > step) continue;
-        label[j] = next_label;
-        members.push_back(j);
+  for (int v0 = 0; v0 < height; v0 += stride) {
+    for (int u0 = 0; u0 < width; u0 += stride) {
+      const int seed = v0 * width + u0;
+      if (label[seed] >= 0 || !frame.isValid(seed)) continue;
+      members.clear();
+      members.push_back(seed);
+      label[seed] = next_label;
+      for (std::size_t head = 0; head < members.size(); ++head) {
+        const int i = members[head];
+        const int u = i % width, v = i / width;
+        const float r = frame.range_m[i];
+        const float step = static_cast<float>(
+            options.connect_step_m + stride * r * options.fit.pixel_pitch_rad * options.slope_allowance);
+        const int neighbours[4] = {u >= stride ? i - stride : -1, u + stride < width ? i + stride : -1,
+                                   v >= stride ? i - stride * width : -1,
+                                   v + stride < height ? i + stride * width : -1};
+        for (int j : neighbours) {
+          if (j < 0 || label[j] >= 0 || !frame.isValid(j)) continue;
+          if (std::abs(frame.range_m[j] - r) > step) continue;
+          label[j] = next_label;
+          members.push_back(j);
+        }
       }
-    }
-    ++next_label;
-    if (static_cast<int>(members.size()) < options.min_cluster_pixels) continue;
-    ++detection->clusters;
-    ClusterMetrics metrics;
-    if (!scoreCluster(frame, members, label, next_label - 1, options, &metrics)) continue;
-    if (detection->found && members.size() <= detection->pixels.size()) continue;
-    detection->found = true;
-    detection->pixels.clear();
-    for (int i : members) {
-      if (std::abs(metrics.normal.dot(frame.points[i].cast<double>() - metrics.centre)) <=
-          3.0 * options.max_planarity_m) {
-        detection->pixels.push_back(i);
+      ++next_label;
+      if (static_cast<int>(members.size()) * stride * stride < options.min_cluster_pixels) continue;
+      ++detection->clusters;
+      ClusterMetrics metrics;
+      if (!scoreCluster(frame, members, label, next_label - 1, options, &metrics)) continue;
+      if (detection->found && members.size() <= detection->pixels.size()) continue;
+      detection->found = true;
+      detection->pixels.clear();
+      for (int i : members) {
+        // The stride x stride block of each member, where on the cluster's plane.
+        for (int dv = 0; dv < stride && i / width + dv < height; ++dv) {
+          for (int du = 0; du < stride && i % width + du < width; ++du) {
+            const int j = i + dv * width + du;
+            if (frame.isValid(j) &&
+                std::abs(metrics.normal.dot(frame.points[j].cast<double>() - metrics.centre)) <=
+                    3.0 * options.max_planarity_m) {
+              detection->pixels.push_back(j);
+            }
+          }
+        }
       }
+      detection->normal = metrics.normal;
+      detection->centre = metrics.centre;
+      detection->radius_m = metrics.radius;
+      detection->planarity_m = metrics.planarity;
+      detection->radial_spread_m = metrics.spread;
+      detection->depth_step_m = metrics.depth_step;
     }
-    detection->normal = metrics.normal;
-    detection->centre = metrics.centre;
-    detection->radius_m = metrics.radius;
-    detection->planarity_m = metrics.planarity;
-    detection->radial_spread_m = metrics.spread;
-    detection->depth_step_m = metrics.depth_step;
   }
 }
 

@@ -115,9 +115,12 @@ class AdapterFitter {
   const AdapterFitOptions& options() const { return options_; }
 
  private:
+  // The adapter's faces parallel to the docking plane: ring, tunnel, hatch, target plate, cross.
+  static constexpr int kFaces = 5;
   struct PlanePoint {
     Eigen::Vector3d p;
     double face_x;  // the face's x in the port frame
+    int face;       // 0..kFaces-1
     int pixel;
   };
   // One pass of labels, plane fit, ring edges, circle and cross from a guess of the port's pose.

@@ -2,9 +2,9 @@
 // metrics, without a docking cross, then hands the ring's pixels to the shared back end (adapter_fit.h) for
 // the plane and circle fit. ROS-free.
 //
-// Clustering: region growing over the 4-neighbour pixel grid; neighbours join when their ranges differ by
-// less than connect_step_m plus a slope allowance (the ring's face and the tunnel face 0.12 m behind it stay
-// apart). Metrics per cluster, each with its criterion:
+// Clustering: region growing over the 4-neighbour grid of every stride-th pixel (in u and v); neighbours join
+// when their ranges differ by less than connect_step_m plus a slope allowance (the ring's face and the tunnel
+// face 0.12 m behind it stay apart). Metrics per cluster, each with its criterion:
 //   size         pixel count >= min_cluster_pixels, in-plane extent (sqrt of the largest covariance
 //   eigenvalue)
 //                within [min_extent_m, max_extent_m] (a full annulus 0.42-0.60 m has 0.37 m)
@@ -33,6 +33,7 @@ namespace ardsim_pose {
 namespace close_range {
 
 struct RingDetectorOptions {
+  int stride = 1;  // clusters grow over every stride-th pixel in u and v (speed; 2 loses the ring at times)
   double connect_step_m = 0.04;  // plus range * pixel pitch * slope_allowance
   double slope_allowance = 0.8;
   int min_cluster_pixels = 40;
