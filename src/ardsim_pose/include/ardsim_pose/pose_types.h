@@ -8,8 +8,8 @@
 
 namespace ardsim_pose {
 
-// One organized LIDAR frame in lidar_optical: row-major, row 0 at the top (y down), a NaN point where there was no
-// return. The same layout as lidar/points.
+// One organized LIDAR frame in lidar_optical: row-major, row 0 at the top (y down), a NaN point where there
+// was no return. The same layout as lidar/points.
 struct OrganizedCloud {
   int width = 0;
   int height = 0;
@@ -26,7 +26,8 @@ struct PoseResult {
   EstimateMethod method = EstimateMethod::kNone;
   std::string reason;  // why DEGRADED or LOST
   Eigen::Isometry3d T_lidar_target = Eigen::Isometry3d::Identity();
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // (x y z, rot x y z) m^2, rad^2
+  Eigen::Matrix<double, 6, 6> covariance =
+      Eigen::Matrix<double, 6, 6>::Zero();  // (x y z, rot x y z) m^2, rad^2
   bool boresight_rotation_observed = true;
   double fit_rms_m = 0.0;
   double inlier_fraction = 0.0;
@@ -34,11 +35,13 @@ struct PoseResult {
   int iterations = 0;
 };
 
-// A method that estimates T_lidar_target in one frame from a prediction (previous estimates or the initial prior).
+// A method that estimates T_lidar_target in one frame from a prediction (previous estimates or the initial
+// prior).
 class PoseMethod {
  public:
   virtual ~PoseMethod() = default;
-  virtual PoseResult estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_lidar_target_predicted) = 0;
+  virtual PoseResult estimate(const OrganizedCloud& cloud,
+                              const Eigen::Isometry3d& T_lidar_target_predicted) = 0;
   // Forget any state carried between frames.
   virtual void reset() = 0;
 };

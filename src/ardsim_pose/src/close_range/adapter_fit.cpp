@@ -301,7 +301,14 @@ bool AdapterFitter::fitCross(const std::vector<Eigen::Vector2d>& points, Eigen::
     const double a1 = std::atan2(direction[1].y(), direction[1].x()) - M_PI / 2.0;
     *angle = a0 + 0.5 * wrapPi(a1 - a0);
   }
-  return true;
+  // A cross, not a blob at the cross's depth: nearly all points within an arm's width of its centre line.
+  const Eigen::Vector2d axis0(std::cos(*angle), std::sin(*angle)), axis1(-std::sin(*angle), std::cos(*angle));
+  int on_arms = 0;
+  for (const Eigen::Vector2d& s : points) {
+    const Eigen::Vector2d offset = s - *centre;
+    if (std::abs(offset.dot(axis0)) < half_width || std::abs(offset.dot(axis1)) < half_width) ++on_arms;
+  }
+  return on_arms >= 0.85 * points.size();
 }
 
 bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
@@ -589,6 +596,8 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   r.report.cross_angle = r.report.cross;
   const double petal_angle = std::arg(petal_sum) / 3.0;
   const double cross_angle = r.cross_angle;
+  const double cross_pixel_m = (std::abs(r.d) - g.cross_face_x_m) * options_.pixel_pitch_rad;
+  const bool cross_fine = cross_pixel_m < 0.01;  // arms 4+ pixels wide
   double boresight = prior_angle;
   if (r.report.petals && r.report.cross_angle) {
     // The one petal branch that agrees with a cross branch (wrong pairs differ by 30 deg or more).
@@ -598,7 +607,9 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
       const double partner = nearestBranch(cross_angle, M_PI / 2.0, candidate);
       if (std::abs(wrapPi(candidate - partner)) < best) {
         best = std::abs(wrapPi(candidate - partner));
-        boresight = candidate + 0.5 * wrapPi(partner - candidate);
+        // The cross's arms are a few pixels wide only when near (cross_fine): then the two are averaged,
+        // otherwise the cross only picks the petals' branch.
+        boresight = cross_fine ? candidate + 0.5 * wrapPi(partner - candidate) : candidate;
       }
     }
   } else if (r.report.petals) {

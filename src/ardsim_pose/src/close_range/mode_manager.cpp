@@ -86,5 +86,28 @@ Eigen::Isometry3d blendPoses(const Eigen::Isometry3d& from, const Eigen::Isometr
   return T;
 }
 
+ModeSelector::ModeSelector(const ModeManagerOptions& options, const Eigen::Isometry3d& T_target_port)
+    : manager_(options), T_target_port_(T_target_port) {}
+
+EstimateMethod ModeSelector::select(const SelectionInput& input) {
+  const double port_range_m = (input.T_lidar_target_predicted * T_target_port_).translation().norm();
+  const double fill = input.cloud ? viewFill(*input.cloud) : 0.0;
+  const bool last_lost = input.previous && input.previous->status == EstimateStatus::kLost;
+  decision_ = manager_.update(port_range_m, fill, last_lost);
+  return decision_.method;
+}
+
+bool ModeSelector::blending(EstimateMethod* from, double* weight) const {
+  if (!decision_.blending()) return false;
+  *from = decision_.previous;
+  *weight = decision_.weight;
+  return true;
+}
+
+void ModeSelector::reset() {
+  manager_.reset();
+  decision_ = ModeManager::Decision();
+}
+
 }  // namespace close_range
 }  // namespace ardsim_pose

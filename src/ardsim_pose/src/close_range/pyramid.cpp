@@ -158,6 +158,9 @@ PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
       }
     }
   }
+  // Too few passing cells (the ring only a few pixels wide, far out, or leaving the view): the back end
+  // labels the ring from the prediction instead.
+  if (static_cast<int>(ring_pixels_.size()) < options_.fit.min_plane_points) ring_pixels_.clear();
   return fitter_.fit(frame_, ring_pixels_, T_lidar_port_prior, T_lidar_port_prior, EstimateMethod::kPyramid,
                      &report_);
 }

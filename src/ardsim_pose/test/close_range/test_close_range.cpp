@@ -1,6 +1,7 @@
 // The close-range methods on rendered frames of the ISS docking adapter (issue 5 goals).
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -139,6 +140,59 @@ INSTANTIATE_TEST_SUITE_P(Methods, CloseRangeGoals,
                          ::testing::Combine(::testing::Values(EstimateMethod::kRing,
                                                               EstimateMethod::kPyramid),
                                             ::testing::Bool()));
+
+}  // namespace
+}  // namespace close_range
+}  // namespace ardsim_pose
+
+namespace ardsim_pose {
+namespace close_range {
+namespace {
+
+// Either LOST, or (if a method still finds the adapter) an estimate within the goals: never a wrong pose.
+void expectLostOrRight(PoseMethod& method, const OrganizedCloud& cloud, const Eigen::Isometry3d& prediction,
+                       const Eigen::Isometry3d& truth, bool expect_lost) {
+  const PoseResult result = method.estimate(cloud, prediction);
+  if (expect_lost) EXPECT_EQ(result.status, EstimateStatus::kLost) << result.reason;
+  if (result.status == EstimateStatus::kLost) return;
+  const testing::PortError e = testing::portError(result.T_lidar_target, truth);
+  EXPECT_LT(e.lateral(), 0.02);
+  EXPECT_LT(std::abs(e.range_m), 0.01);
+}
+
+TEST(CloseRangeLost, RingOutOfViewOccludedOrEmpty) {
+  IssRenderer renderer(true);
+  RingMethod ring;
+  PyramidMethod pyramid;
+  for (double range : {4.0, 2.0, 0.5}) {
+    ApproachState s;
+    s.port_range_m = range;
+    const Eigen::Isometry3d truth = testing::T_lidar_target(s);
+    // The chaser turned 25 deg away: the adapter leaves the 20 deg field of view (the modules behind remain).
+    ApproachState away = s;
+    away.tilt_z_deg = 25.0;
+    const Eigen::Isometry3d truth_away = testing::T_lidar_target(away);
+    const OrganizedCloud cloud_away = renderer.render(truth_away, 1);
+    for (PoseMethod* method : {static_cast<PoseMethod*>(&ring), static_cast<PoseMethod*>(&pyramid)}) {
+      SCOPED_TRACE("range " + std::to_string(range));
+      // Predicted where it is (a tracker following the turn): the adapter is out of view.
+      expectLostOrRight(*method, cloud_away, truth_away, truth_away, true);
+      // Occluded: all but a strip along the top of the image blanked (no ring edge, no cross).
+      OrganizedCloud occluded = renderer.render(truth, 2);
+      for (std::size_t i = 30 * occluded.width; i < occluded.points.size(); ++i) {
+        occluded.points[i] = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+      }
+      expectLostOrRight(*method, occluded, truth, truth, true);
+      OrganizedCloud empty = occluded;
+      for (auto& p : empty.points) p = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+      expectLostOrRight(*method, empty, truth, truth, true);
+      OrganizedCloud malformed;
+      malformed.width = 256;
+      malformed.height = 256;  // no points at all
+      EXPECT_EQ(method->estimate(malformed, truth).status, EstimateStatus::kLost);
+    }
+  }
+}
 
 }  // namespace
 }  // namespace close_range

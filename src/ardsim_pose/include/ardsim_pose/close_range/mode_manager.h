@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include "ardsim_pose/pose_estimator.h"
 #include "ardsim_pose/pose_types.h"
 
 namespace ardsim_pose {
@@ -62,6 +63,22 @@ class ModeManager {
 
 // Pose between `from` (weight 0) and `to` (weight 1): translation interpolated linearly, rotation by slerp.
 Eigen::Isometry3d blendPoses(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double weight);
+
+// The estimator facade's "auto" selector: the mode manager fed from the facade's prediction (range of the
+// target port, geometry.T_target_port), the frame's view fill and whether the last frame was LOST.
+class ModeSelector : public MethodSelector {
+ public:
+  ModeSelector(const ModeManagerOptions& options, const Eigen::Isometry3d& T_target_port);
+  EstimateMethod select(const SelectionInput& input) override;
+  bool blending(EstimateMethod* from, double* weight) const override;
+  void reset() override;
+  const ModeManager::Decision& lastDecision() const { return decision_; }
+
+ private:
+  ModeManager manager_;
+  Eigen::Isometry3d T_target_port_;
+  ModeManager::Decision decision_;
+};
 
 }  // namespace close_range
 }  // namespace ardsim_pose

@@ -20,8 +20,10 @@
 //   edge cell: ring-band fraction >= min_edge_fraction and behind fraction >= min_edge_fraction (the ring's
 //              inner edge, the passage behind it);
 // The ring-band pixels of face and edge cells are the ring's pixels: the plane comes from them (and the
-// adapter's other faces), the centre from the edges found in the edge cells. Without any passing cell (the
-// ring out of view near contact) the back end tracks the hatch and the centreline target; with neither: LOST.
+// adapter's other faces), the centre from the edges found in the edge cells. With fewer ring pixels than the
+// back end's min_plane_points (beyond ~9 m the annulus is narrower than a fine cell) the ring is labelled
+// from the prediction instead. Without any passing cell (the ring out of view near contact) the back end
+// tracks the hatch and the centreline target; with neither: LOST.
 #pragma once
 
 #include <array>

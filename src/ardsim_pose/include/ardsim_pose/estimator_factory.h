@@ -1,0 +1,47 @@
+// Builds the estimator of a configuration: the reference model of the target's rigid structure, the methods
+// and the method selector. Where the node, evaluate_dataset, the tests and the benchmark get theirs.
+// ROS-free.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "ardsim_description/frames.h"
+#include "ardsim_lidar/sensor.h"
+#include "ardsim_pose/close_range/mode_manager.h"
+#include "ardsim_pose/close_range/pyramid.h"
+#include "ardsim_pose/close_range/ring_detector.h"
+#include "ardsim_pose/icp_tracker.h"
+#include "ardsim_pose/pose_estimator.h"
+#include "ardsim_pose/reference_model.h"
+
+namespace ardsim_pose {
+
+struct PoseConfig {
+  ardsim_description::TargetKind target = ardsim_description::TargetKind::kIss;
+  ardsim_lidar::SensorOptions sensor;  // width, height and fov_deg must match the lidar's
+  // "icp", "ring", "pyramid": that method every frame. "auto": the close-range mode manager (ICP far out, the
+  // close-range method near; ICP only for targets without the docking adapter's close-range model, Hubble).
+  std::string method = "icp";
+  ReferenceModelOptions model;
+  VisibilityOptions visibility;
+  IcpOptions icp;
+  EstimatorOptions estimator;
+  close_range::RingDetectorOptions ring;
+  close_range::PyramidOptions pyramid;
+  close_range::ModeManagerOptions mode;
+};
+
+// Throws std::invalid_argument naming the option, its value and the allowed values.
+void validate(const PoseConfig& config);
+
+// The rigid structure (articulated parts left out) of the target, sampled.
+std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::TargetKind kind,
+                                                          const ReferenceModelOptions& options);
+
+std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config);
+// The same with a model already built (it is shared, read-only, between estimators).
+std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
+                                             std::shared_ptr<const ReferenceModel> model);
+
+}  // namespace ardsim_pose

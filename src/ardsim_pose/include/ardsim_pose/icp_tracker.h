@@ -1,0 +1,94 @@
+// Model-based ICP tracking of T_lidar_target from one organized cloud: point-to-plane against the reference
+// model cropped to what the sensor can see from the predicted pose, Tukey-weighted residuals, quality checks
+// that say TRACKING, DEGRADED or LOST, and the covariance from the final normal equations. ROS-free.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "ardsim_lidar/sensor.h"
+#include "ardsim_pose/pose_types.h"
+#include "ardsim_pose/reference_model.h"
+
+namespace ardsim_pose {
+
+struct IcpOptions {
+  int max_points = 1000;                // scan points per frame (evenly spread over the valid pixels)
+  int max_iterations_tracking = 15;     // per frame once tracking
+  int max_iterations_acquisition = 40;  // per frame while acquiring (from a prior or after LOST)
+  double gate_tracking_m = 0.5;         // first correspondence gate when tracking
+  double gate_acquisition_m = 3.0;      // first correspondence gate while acquiring
+  double gate_min_m = 0.3;    // the gate shrinks to 4 x the median correspondence distance, not below
+  double tukey_c = 4.685;     // Tukey biweight constant, in robust sigmas of the plane residuals
+  double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
+  double converged_translation_m = 1e-4;  // an update smaller than both ends the iterations
+  double converged_rotation_rad = 1e-5;
+  double revisibility_translation_m = 0.3;  // recompute the visibility when the pose moved more than this
+  double revisibility_rotation_rad = 0.02;
+  // Quality: below the `lost_` limits the frame is LOST, below the `degraded_` ones DEGRADED.
+  int min_points = 50;  // valid scan points, and correspondences
+  // Scan points within the Tukey limit of the model. Low at long range, where the solar arrays (not in the
+  // model) fill much of the view.
+  double lost_inlier_fraction = 0.15;
+  double degraded_inlier_fraction = 0.3;
+  double lost_fit_rms_m = 0.15;  // RMS plane residual of the inliers
+  double degraded_fit_rms_m = 0.05;
+  double lost_coverage = 0.35;  // predicted-visible model cells that the scan confirms
+  double degraded_coverage = 0.55;
+  double degraded_condition = 1e-3;     // smallest / largest eigenvalue of the scaled normal equations
+  double confirm_translation_m = 0.05;  // acquiring: TRACKING once a frame moves less than this from the last
+  double confirm_rotation_rad = 0.0035;
+  double max_correction_m = 1.5;  // when tracking: a larger jump from the prediction is a divergence
+  double max_correction_rad = 0.1;
+};
+
+// Throws std::invalid_argument naming the option, its value and the allowed range.
+void validate(const IcpOptions& options);
+
+class IcpTracker : public PoseMethod {
+ public:
+  IcpTracker(std::shared_ptr<const ReferenceModel> model, const ardsim_lidar::Intrinsics& intrinsics,
+             const IcpOptions& options = {}, const VisibilityOptions& visibility = {});
+
+  PoseResult estimate(const OrganizedCloud& cloud,
+                      const Eigen::Isometry3d& T_lidar_target_predicted) override;
+  // Back to acquisition: the next frame starts from its prediction with the wide gate and more iterations.
+  void reset() override { acquiring_ = true; }
+
+  bool acquiring() const { return acquiring_; }
+  // Of the last frame: fraction of the cells where the model is predicted that the scan confirms.
+  double lastCoverage() const { return coverage_; }
+  // Of the last frame: the visibility mask and the scan subsample (lidar frame), for benchmarks and tests.
+  const std::vector<std::uint8_t>& lastVisible() const { return visible_; }
+  const std::vector<Eigen::Vector3f>& lastScanPoints() const { return scan_; }
+  const ReferenceModel& model() const { return *model_; }
+  const IcpOptions& options() const { return options_; }
+
+ private:
+  double coverage() const;
+  void alignRange(Eigen::Isometry3d* T);
+
+  std::shared_ptr<const ReferenceModel> model_;
+  ardsim_lidar::Intrinsics intrinsics_;
+  IcpOptions options_;
+  VisibilityPredictor visibility_;
+  bool acquiring_ = true;
+  double coverage_ = 0.0;
+  std::vector<std::uint8_t> visible_;
+  std::vector<Eigen::Vector3f> scan_;
+  std::vector<Eigen::Vector3f> active_;  // scan points still searched for
+  std::vector<int> valid_;
+  std::vector<float> scan_depth_;
+  struct Correspondence {
+    Eigen::Vector3d scan;    // lidar frame
+    Eigen::Vector3d model;   // lidar frame, at the current pose
+    Eigen::Vector3d normal;  // lidar frame
+    double residual;         // along the normal, m
+    double distance;         // point to point, m
+  };
+  std::vector<Correspondence> correspondences_;
+  std::vector<double> scratch_;
+};
+
+}  // namespace ardsim_pose

@@ -1,0 +1,93 @@
+// The estimator facade that the node and evaluate_dataset drive, one frame at a time: it predicts the pose
+// from the previous estimates, asks a MethodSelector which PoseMethod runs this frame (ICP only for now; the
+// close-range mode manager is another selector over more methods), and follows the method with an optional
+// median filter and the relative velocity. ROS-free.
+#pragma once
+
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "ardsim_pose/pose_types.h"
+
+namespace ardsim_pose {
+
+// What a selector may look at to choose the method for a frame.
+struct SelectionInput {
+  const OrganizedCloud* cloud = nullptr;
+  Eigen::Isometry3d T_lidar_target_predicted = Eigen::Isometry3d::Identity();
+  const PoseResult* previous = nullptr;  // the last frame's result; nullptr on the first frame
+};
+
+class MethodSelector {
+ public:
+  virtual ~MethodSelector() = default;
+  // One of the estimator's methods (a key of its method map).
+  virtual EstimateMethod select(const SelectionInput& input) = 0;
+  // After select: whether the estimate is to be blended from another method's (run on the same frame and
+  // prediction) into the selected one's, and the selected one's weight (0..1); the output then does not jump
+  // at a hand-over.
+  virtual bool blending(EstimateMethod* /*from*/, double* /*weight*/) const { return false; }
+  virtual void reset() {}
+};
+
+// Always the same method (ICP while it is the only one).
+class FixedMethodSelector : public MethodSelector {
+ public:
+  explicit FixedMethodSelector(EstimateMethod method) : method_(method) {}
+  EstimateMethod select(const SelectionInput&) override { return method_; }
+
+ private:
+  EstimateMethod method_;
+};
+
+struct EstimatorOptions {
+  bool median_filter = false;  // median of the last median_window estimates (as in the study): smoother, lags
+  int median_window = 5;       // frames, odd
+  double velocity_smoothing =
+      0.5;  // weight of the new difference in the velocity's exponential smoothing, 0..1
+  double max_prediction_gap_s = 2.0;  // a longer gap since the last good estimate: predict without velocity
+};
+void validate(const EstimatorOptions& options);
+
+struct EstimatorOutput {
+  PoseResult result;                                                 // after the median filter when it is on
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();            // target origin, in lidar_optical
+  Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();  // in lidar_optical
+  bool velocity_valid = false;
+  double compute_ms = 0.0;  // wall clock of this frame, diagnostic only
+};
+
+class PoseEstimator {
+ public:
+  using Methods = std::map<EstimateMethod, std::unique_ptr<PoseMethod>>;
+  PoseEstimator(const EstimatorOptions& options, Methods methods, std::unique_ptr<MethodSelector> selector);
+
+  // The pose to start from (initial estimate or prior); forgets all history and resets the methods.
+  void setPrior(const Eigen::Isometry3d& T_lidar_target);
+  EstimatorOutput process(const OrganizedCloud& cloud);
+  // The pose the next frame at stamp_s will start from.
+  Eigen::Isometry3d predict(double stamp_s) const;
+
+ private:
+  void updateVelocity(const Eigen::Isometry3d& T, EstimateStatus status, double stamp_s);
+  Eigen::Isometry3d medianOf(const std::deque<Eigen::Isometry3d>& poses) const;
+
+  EstimatorOptions options_;
+  Methods methods_;
+  std::unique_ptr<MethodSelector> selector_;
+  Eigen::Isometry3d prior_ = Eigen::Isometry3d::Identity();
+  bool have_good_ = false;  // a TRACKING or DEGRADED estimate since the prior
+  Eigen::Isometry3d last_good_ = Eigen::Isometry3d::Identity();
+  bool last_good_tracking_ = false;
+  double last_good_stamp_s = 0.0;
+  Eigen::Vector3d velocity_mps_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity_radps_ = Eigen::Vector3d::Zero();
+  bool velocity_valid_ = false;
+  PoseResult previous_;
+  bool have_previous_ = false;
+  std::deque<Eigen::Isometry3d> recent_;  // good raw estimates, for the median filter
+};
+
+}  // namespace ardsim_pose

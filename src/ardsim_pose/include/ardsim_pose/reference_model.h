@@ -1,0 +1,123 @@
+// The ICP's a-priori model: the target's rigid structure (articulated parts such as solar arrays and
+// radiators left out, they turn) sampled to points with their triangle's normal, a KD-tree over all of them
+// built once, and the per-frame visibility prediction that crops it to what the sensor can see from a pose.
+// ROS-free.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "ardsim_description/mesh.h"
+#include "ardsim_lidar/sensor.h"
+
+namespace ardsim_pose {
+
+struct ReferenceModelOptions {
+  // Sample spacing on the surfaces grows with the distance from the docking port: the port is seen from
+  // metres, the far structure only from tens of metres, where a pixel is as wide as the coarser spacing.
+  double spacing_at_port_m = 0.03;
+  double spacing_growth_per_m = 0.004;  // spacing added per metre of distance from the port
+  double max_spacing_m = 0.25;
+  double patch_spacings =
+      4.0;  // visibility is decided per patch: samples of one triangle within this many spacings
+  double chunk_size_m = 3.0;  // patches are culled against the view frustum in cubes of this size
+};
+
+// Throws std::invalid_argument naming the option, its value and the allowed range.
+void validate(const ReferenceModelOptions& options);
+
+class ReferenceModel {
+ public:
+  // mesh: the rigid structure in the target body frame; T_target_port: where the spacing is finest.
+  ReferenceModel(const ardsim_description::TriangleMesh& mesh, const Eigen::Isometry3d& T_target_port,
+                 const ReferenceModelOptions& options = {});
+  ~ReferenceModel();
+  ReferenceModel(const ReferenceModel&) = delete;
+  ReferenceModel& operator=(const ReferenceModel&) = delete;
+
+  std::size_t size() const { return points_.size(); }
+  const std::vector<Eigen::Vector3f>& points() const { return points_; }    // target frame, m
+  const std::vector<Eigen::Vector3f>& normals() const { return normals_; }  // unit, outward
+  const std::vector<float>& spacing() const { return spacing_; }            // m, per point
+
+  // Nearest point with visible[index] != 0 within sqrt(max_distance_sq) of query (target frame); -1 if none.
+  int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
+                     const std::vector<std::uint8_t>& visible, float* distance_sq) const;
+
+  // Samples of one triangle close together: one visibility decision for all (points [begin, end)).
+  struct Patch {
+    Eigen::Vector3f centre;
+    Eigen::Vector3f normal;
+    float radius = 0.0f;
+    std::uint32_t begin = 0;
+    std::uint32_t end = 0;
+  };
+  // Patches close together: one frustum test for all (patches [begin, end)).
+  struct Chunk {
+    Eigen::Vector3f centre;
+    float radius = 0.0f;
+    std::uint32_t begin = 0;
+    std::uint32_t end = 0;
+  };
+  const std::vector<Patch>& patches() const { return patches_; }
+  const std::vector<Chunk>& chunks() const { return chunks_; }
+
+ private:
+  struct KdTree;
+  std::vector<Eigen::Vector3f> points_;
+  std::vector<Eigen::Vector3f> normals_;
+  std::vector<float> spacing_;
+  std::vector<Patch> patches_;
+  std::vector<Chunk> chunks_;
+  std::unique_ptr<KdTree> tree_;
+};
+
+struct VisibilityOptions {
+  int cell_px = 4;          // the depth buffer's cells are cell_px x cell_px sensor pixels
+  double margin_px = 12.0;  // points this far outside the image still count (the prediction is not exact)
+  double depth_tolerance_m =
+      0.2;  // a point within this (or 3 cells' width) behind the nearest surface is seen
+};
+void validate(const VisibilityOptions& options);
+
+// What the sensor can see of the model from a pose: front-facing patches inside the field of view (plus
+// margin) and not hidden by nearer structure, by a coarse depth buffer of splatted patches.
+class VisibilityPredictor {
+ public:
+  VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options);
+
+  // Fills visible (one flag per model point) and the per-cell depth of the nearest predicted surface.
+  // Returns the number of visible points.
+  int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
+              std::vector<std::uint8_t>* visible);
+
+  int gridWidth() const { return grid_width_; }
+  int gridHeight() const { return grid_height_; }
+  int cellPx() const { return options_.cell_px; }
+  // Nearest predicted model depth (lidar z, m) per cell from the last predict(); +inf where no model surface.
+  const std::vector<float>& modelDepth() const { return model_depth_; }
+  // Cell of a pixel (inside the image).
+  int cellOfPixel(int u, int v) const { return (v / options_.cell_px) * grid_width_ + u / options_.cell_px; }
+
+ private:
+  ardsim_lidar::Intrinsics intrinsics_;
+  VisibilityOptions options_;
+  int grid_width_ = 0;
+  int grid_height_ = 0;
+  int margin_cells_ = 0;
+  int padded_width_ = 0;
+  int padded_height_ = 0;
+  std::vector<float> depth_;        // padded grid
+  std::vector<float> model_depth_;  // image grid
+  struct Candidate {
+    std::uint32_t patch;
+    std::int32_t cell;  // padded grid
+    float depth;
+  };
+  std::vector<Candidate> candidates_;
+};
+
+}  // namespace ardsim_pose

@@ -1,0 +1,44 @@
+// All conversions between ROS messages and the ardsim_pose core, in one place (unit-tested in
+// test/test_conversions.cpp).
+#pragma once
+
+#include <string>
+
+#include <ardsim_msgs/PoseError.h>
+#include <ardsim_msgs/PoseEstimate.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <Eigen/Geometry>
+
+#include "ardsim_pose/evaluation.h"
+#include "ardsim_pose/pose_estimator.h"
+
+namespace ardsim_pose {
+
+// Organized cloud from lidar/points (float32 x, y, z; intensity optional). Returns false and says why in
+// *error for a cloud that is not organized, lacks a field, has another type or too little data. An empty
+// cloud (0 points) converts (to an empty frame).
+bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, OrganizedCloud* cloud, std::string* error);
+
+ardsim_msgs::PoseEstimatePtr toPoseEstimate(const EstimatorOutput& output, const std_msgs::Header& header);
+
+geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& T_parent_child,
+                                            const std_msgs::Header& header,
+                                            const std::string& child_frame_id);
+
+// Pose from an estimate. Returns false (and says why) for a non-finite value or a non-unit quaternion.
+bool poseFromEstimate(const ardsim_msgs::PoseEstimate& msg, Eigen::Isometry3d* T_lidar_target,
+                      std::string* error);
+
+// Body pose in eci from truth odometry. Returns false (and says why) for a non-finite value or a non-unit
+// quaternion.
+bool poseFromOdometry(const nav_msgs::Odometry& msg, Eigen::Isometry3d* T_eci_body, std::string* error);
+
+// T_lidar_target from the truth odometries, the eci positions (about 7e6 m) subtracted first.
+Eigen::Isometry3d lidarFromTruth(const Eigen::Isometry3d& T_eci_target, const Eigen::Isometry3d& T_eci_chaser,
+                                 const Eigen::Isometry3d& T_chaser_lidar);
+
+ardsim_msgs::PoseErrorPtr toPoseError(const PoseErrorValue& error, const ardsim_msgs::PoseEstimate& estimate);
+
+}  // namespace ardsim_pose

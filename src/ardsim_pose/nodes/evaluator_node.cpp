@@ -1,0 +1,103 @@
+// pose_evaluator: publishes pose/error (estimate minus truth at the same stamp) for every pose/estimate.
+// Truth T_lidar_target comes from truth/target/odom and truth/chaser/odom (paired by exact stamp) with
+// T_chaser_lidar. Either side may arrive first: both wait in bounded buffers keyed by stamp. Evaluation only.
+#include <map>
+#include <string>
+
+#include <ardsim_msgs/log_throttle.h>
+#include <ros/ros.h>
+
+#include "ardsim_description/frames.h"
+#include "conversions.h"
+
+namespace ardsim_pose {
+
+class PoseEvaluator {
+ public:
+  PoseEvaluator(ros::NodeHandle nh, const ros::NodeHandle& private_nh) {
+    std::string target = "iss";
+    private_nh.param("target", target, target);
+    try {
+      T_target_port_ = ardsim_description::T_target_port(ardsim_description::parseTargetKind(target));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("parameter target: ") + e.what());
+    }
+    private_nh.param("buffer_size", buffer_size_, buffer_size_);
+    if (buffer_size_ < 1 || buffer_size_ > 10000)
+      throw std::invalid_argument("parameter buffer_size = " + std::to_string(buffer_size_) +
+                                  " is out of range: 1 .. 10000");
+    T_chaser_lidar_ = ardsim_description::T_chaser_lidar();
+    error_publisher_ = nh.advertise<ardsim_msgs::PoseError>("pose/error", 10, true);
+    estimate_subscriber_ = nh.subscribe("pose/estimate", 10, &PoseEvaluator::onEstimate, this);
+    target_subscriber_ = nh.subscribe("truth/target/odom", 10, &PoseEvaluator::onTarget, this);
+    chaser_subscriber_ = nh.subscribe("truth/chaser/odom", 10, &PoseEvaluator::onChaser, this);
+  }
+
+ private:
+  template <typename Map>
+  void bound(Map* map) {
+    while (static_cast<int>(map->size()) > buffer_size_) map->erase(map->begin());
+  }
+
+  void onTarget(const nav_msgs::OdometryConstPtr& msg) {
+    target_[msg->header.stamp] = msg;
+    bound(&target_);
+    evaluate(msg->header.stamp);
+  }
+  void onChaser(const nav_msgs::OdometryConstPtr& msg) {
+    chaser_[msg->header.stamp] = msg;
+    bound(&chaser_);
+    evaluate(msg->header.stamp);
+  }
+  void onEstimate(const ardsim_msgs::PoseEstimateConstPtr& msg) {
+    estimates_[msg->header.stamp] = msg;
+    bound(&estimates_);
+    evaluate(msg->header.stamp);
+  }
+
+  void evaluate(const ros::Time& stamp) {
+    const auto estimate = estimates_.find(stamp);
+    const auto target = target_.find(stamp);
+    const auto chaser = chaser_.find(stamp);
+    if (estimate == estimates_.end() || target == target_.end() || chaser == chaser_.end()) return;
+    Eigen::Isometry3d T_eci_target, T_eci_chaser, T_estimate;
+    std::string error;
+    if (!poseFromOdometry(*target->second, &T_eci_target, &error) ||
+        !poseFromOdometry(*chaser->second, &T_eci_chaser, &error) ||
+        !poseFromEstimate(*estimate->second, &T_estimate, &error)) {
+      ARDSIM_WARN_THROTTLE(5.0, "pose_evaluator: cannot evaluate t = %.6f: %s", stamp.toSec(), error.c_str());
+    } else {
+      const Eigen::Isometry3d truth = lidarFromTruth(T_eci_target, T_eci_chaser, T_chaser_lidar_);
+      error_publisher_.publish(toPoseError(poseError(T_estimate, truth, T_target_port_), *estimate->second));
+    }
+    // This stamp is done; older ones will not be completed either.
+    estimates_.erase(estimates_.begin(), std::next(estimate));
+    target_.erase(target_.begin(), std::next(target));
+    chaser_.erase(chaser_.begin(), std::next(chaser));
+  }
+
+  int buffer_size_ = 100;
+  Eigen::Isometry3d T_target_port_;
+  Eigen::Isometry3d T_chaser_lidar_;
+  std::map<ros::Time, nav_msgs::OdometryConstPtr> target_;
+  std::map<ros::Time, nav_msgs::OdometryConstPtr> chaser_;
+  std::map<ros::Time, ardsim_msgs::PoseEstimateConstPtr> estimates_;
+  ros::Publisher error_publisher_;
+  ros::Subscriber estimate_subscriber_, target_subscriber_, chaser_subscriber_;
+};
+
+}  // namespace ardsim_pose
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "pose_evaluator");
+  ros::NodeHandle nh;
+  ros::NodeHandle private_nh("~");
+  try {
+    ardsim_pose::PoseEvaluator evaluator(nh, private_nh);
+    ros::spin();
+  } catch (const std::exception& e) {
+    ROS_FATAL("pose_evaluator: %s", e.what());
+    return 2;
+  }
+  return 0;
+}

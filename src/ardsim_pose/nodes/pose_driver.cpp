@@ -1,0 +1,196 @@
+#include "pose_driver.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <ardsim_msgs/log_throttle.h>
+
+#include "ardsim_dynamics/scenario.h"
+#include "conversions.h"
+
+namespace ardsim_pose {
+
+namespace {
+
+// A parameter that is set but has the wrong type is an error, not a silent default.
+template <typename T>
+void read(const ros::NodeHandle& nh, const std::string& name, T* value) {
+  if (!nh.hasParam(name)) return;
+  if (!nh.getParam(name, *value))
+    throw std::invalid_argument("parameter " + name + " has the wrong type (see config/pose.yaml)");
+}
+
+void readVector(const ros::NodeHandle& nh, const std::string& name, Eigen::Vector3d* value) {
+  std::vector<double> v(value->data(), value->data() + 3);
+  read(nh, name, &v);
+  if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+    throw std::invalid_argument("parameter " + name + " is out of range: a list of 3 finite numbers");
+  *value = Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+// Prefixes the core's "name = value is out of range" with the parameter namespace.
+template <typename F>
+void validated(const std::string& what, F check) {
+  try {
+    check();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("parameter " + what + e.what());
+  }
+}
+
+}  // namespace
+
+PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
+  PoseNodeOptions o;
+  PoseConfig& c = o.config;
+  std::string target = ardsim_description::targetKindName(c.target);
+  read(nh, "target", &target);
+  validated("target: ", [&] { c.target = ardsim_description::parseTargetKind(target); });
+  read(nh, "method", &c.method);
+  read(nh, "width", &c.sensor.width);
+  read(nh, "height", &c.sensor.height);
+  read(nh, "fov_deg", &c.sensor.fov_deg);
+  read(nh, "frame_id", &o.frame_id);
+  read(nh, "child_frame_id", &o.child_frame_id);
+  read(nh, "publish_tf", &o.publish_tf);
+
+  read(nh, "model/spacing_at_port_m", &c.model.spacing_at_port_m);
+  read(nh, "model/spacing_growth_per_m", &c.model.spacing_growth_per_m);
+  read(nh, "model/max_spacing_m", &c.model.max_spacing_m);
+  read(nh, "model/patch_spacings", &c.model.patch_spacings);
+  read(nh, "model/chunk_size_m", &c.model.chunk_size_m);
+  read(nh, "visibility/cell_px", &c.visibility.cell_px);
+  read(nh, "visibility/margin_px", &c.visibility.margin_px);
+  read(nh, "visibility/depth_tolerance_m", &c.visibility.depth_tolerance_m);
+  IcpOptions& i = c.icp;
+  read(nh, "icp/max_points", &i.max_points);
+  read(nh, "icp/max_iterations_tracking", &i.max_iterations_tracking);
+  read(nh, "icp/max_iterations_acquisition", &i.max_iterations_acquisition);
+  read(nh, "icp/gate_tracking_m", &i.gate_tracking_m);
+  read(nh, "icp/gate_acquisition_m", &i.gate_acquisition_m);
+  read(nh, "icp/gate_min_m", &i.gate_min_m);
+  read(nh, "icp/tukey_c", &i.tukey_c);
+  read(nh, "icp/min_sigma_m", &i.min_sigma_m);
+  read(nh, "icp/converged_translation_m", &i.converged_translation_m);
+  read(nh, "icp/converged_rotation_rad", &i.converged_rotation_rad);
+  read(nh, "icp/revisibility_translation_m", &i.revisibility_translation_m);
+  read(nh, "icp/revisibility_rotation_rad", &i.revisibility_rotation_rad);
+  read(nh, "icp/min_points", &i.min_points);
+  read(nh, "icp/lost_inlier_fraction", &i.lost_inlier_fraction);
+  read(nh, "icp/degraded_inlier_fraction", &i.degraded_inlier_fraction);
+  read(nh, "icp/lost_fit_rms_m", &i.lost_fit_rms_m);
+  read(nh, "icp/degraded_fit_rms_m", &i.degraded_fit_rms_m);
+  read(nh, "icp/lost_coverage", &i.lost_coverage);
+  read(nh, "icp/degraded_coverage", &i.degraded_coverage);
+  read(nh, "icp/degraded_condition", &i.degraded_condition);
+  read(nh, "icp/confirm_translation_m", &i.confirm_translation_m);
+  read(nh, "icp/confirm_rotation_rad", &i.confirm_rotation_rad);
+  read(nh, "icp/max_correction_m", &i.max_correction_m);
+  read(nh, "icp/max_correction_rad", &i.max_correction_rad);
+  read(nh, "estimator/median_filter", &c.estimator.median_filter);
+  read(nh, "estimator/median_window", &c.estimator.median_window);
+  read(nh, "estimator/velocity_smoothing", &c.estimator.velocity_smoothing);
+  read(nh, "estimator/max_prediction_gap_s", &c.estimator.max_prediction_gap_s);
+  // The core names the option (e.g. "icp/max_points = 3 is out of range: ...").
+  validated("", [&] { validate(c); });
+
+  read(nh, "initial/source", &o.initial_source);
+  if (o.initial_source != "docking_axis" && o.initial_source != "parameters" &&
+      o.initial_source != "scenario")
+    throw std::invalid_argument("parameter initial/source = '" + o.initial_source +
+                                "' is not allowed: docking_axis, parameters or scenario");
+  read(nh, "initial/port_distance_m", &o.initial_port_distance_m);
+  if (!(std::isfinite(o.initial_port_distance_m) && o.initial_port_distance_m > 0.0))
+    throw std::invalid_argument("parameter initial/port_distance_m = " +
+                                std::to_string(o.initial_port_distance_m) + " is out of range: > 0");
+  readVector(nh, "initial/position_m", &o.initial_position_m);
+  readVector(nh, "initial/rpy_deg", &o.initial_rpy_deg);
+  read(nh, "initial/scenario_file", &o.initial_scenario_file);
+  if (o.initial_source == "scenario" && o.initial_scenario_file.empty())
+    throw std::invalid_argument(
+        "parameter initial/scenario_file is required when initial/source is scenario");
+  read(nh, "initial/perturb", &o.initial_perturb);
+  read(nh, "initial/attitude_deg", &o.perturbation.attitude_deg);
+  read(nh, "initial/range_fraction", &o.perturbation.range_fraction);
+  read(nh, "initial/lateral_m", &o.perturbation.lateral_m);
+  if (!(std::isfinite(o.perturbation.attitude_deg) && o.perturbation.attitude_deg >= 0.0 &&
+        o.perturbation.attitude_deg <= 180.0))
+    throw std::invalid_argument("parameter initial/attitude_deg = " +
+                                std::to_string(o.perturbation.attitude_deg) + " is out of range: 0 .. 180");
+  if (!(std::isfinite(o.perturbation.range_fraction) && o.perturbation.range_fraction >= 0.0 &&
+        o.perturbation.range_fraction < 1.0))
+    throw std::invalid_argument("parameter initial/range_fraction = " +
+                                std::to_string(o.perturbation.range_fraction) + " is out of range: 0 .. < 1");
+  if (!(std::isfinite(o.perturbation.lateral_m) && o.perturbation.lateral_m >= 0.0))
+    throw std::invalid_argument("parameter initial/lateral_m = " + std::to_string(o.perturbation.lateral_m) +
+                                " is out of range: >= 0");
+  read(nh, "initial/seed", &o.initial_seed);
+  if (o.initial_seed < 0)
+    throw std::invalid_argument("parameter initial/seed = " + std::to_string(o.initial_seed) +
+                                " is out of range: >= 0");
+  return o;
+}
+
+Eigen::Isometry3d initialEstimate(const PoseNodeOptions& o) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (o.initial_source == "docking_axis") {
+    T = dockingAxisPose(o.config.target, o.initial_port_distance_m);
+  } else if (o.initial_source == "parameters") {
+    T.linear() = ardsim_dynamics::rotationFromRollPitchYaw(o.initial_rpy_deg * M_PI / 180.0);
+    T.translation() = o.initial_position_m;
+  } else {
+    const ardsim_dynamics::Scenario scenario = ardsim_dynamics::loadScenario(o.initial_scenario_file);
+    if (scenario.target_kind != o.config.target)
+      throw std::invalid_argument("parameter initial/scenario_file: the scenario's target is " +
+                                  ardsim_description::targetKindName(scenario.target_kind) +
+                                  ", parameter target is " +
+                                  ardsim_description::targetKindName(o.config.target));
+    T = initialFromScenario(scenario);
+  }
+  if (o.initial_perturb)
+    T = perturbPrior(T, ardsim_description::T_target_port(o.config.target), o.perturbation,
+                     static_cast<std::uint64_t>(o.initial_seed));
+  return T;
+}
+
+PoseDriver::PoseDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
+    : options_(loadOptions(private_nh)), estimator_(makeEstimator(options_.config)) {
+  const Eigen::Isometry3d initial = initialEstimate(options_);
+  estimator_->setPrior(initial);
+  // Latched: a subscriber that connects late still gets the current step's estimate.
+  estimate_publisher_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 2, true);
+  cloud_subscriber_ = nh.subscribe("lidar/points", 2, &PoseDriver::onCloud, this);
+  ROS_INFO("pose: %s, method %s, %dx%d %.1f deg, initial %s (%.2f %.2f %.2f m)%s",
+           ardsim_description::targetKindName(options_.config.target).c_str(), options_.config.method.c_str(),
+           options_.config.sensor.width, options_.config.sensor.height, options_.config.sensor.fov_deg,
+           options_.initial_source.c_str(), initial.translation().x(), initial.translation().y(),
+           initial.translation().z(), options_.initial_perturb ? ", perturbed" : "");
+}
+
+void PoseDriver::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  std_msgs::Header header;
+  header.stamp = msg->header.stamp;
+  header.frame_id = options_.frame_id;
+  std::string error;
+  EstimatorOutput output;
+  if (!fromPointCloud2(*msg, &cloud_, &error)) {
+    ARDSIM_WARN_THROTTLE(5.0, "pose: bad cloud at t = %.6f: %s; answering LOST", msg->header.stamp.toSec(),
+                         error.c_str());
+    // Keep the stamp and an empty frame: the estimator answers LOST and keeps its state.
+    cloud_ = OrganizedCloud();
+    cloud_.stamp_s = msg->header.stamp.toSec();
+    output = estimator_->process(cloud_);
+    output.result.reason = "bad cloud: " + error;
+  } else {
+    output = estimator_->process(cloud_);
+  }
+  if (output.result.status == EstimateStatus::kLost)
+    ARDSIM_WARN_THROTTLE(5.0, "pose: LOST at t = %.6f: %s", msg->header.stamp.toSec(),
+                         output.result.reason.c_str());
+  estimate_publisher_.publish(toPoseEstimate(output, header));
+  if (options_.publish_tf && output.result.status != EstimateStatus::kLost)
+    tf_broadcaster_.sendTransform(toTransform(output.result.T_lidar_target, header, options_.child_frame_id));
+}
+
+}  // namespace ardsim_pose

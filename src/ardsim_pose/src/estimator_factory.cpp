@@ -1,0 +1,59 @@
+#include "ardsim_pose/estimator_factory.h"
+
+#include <stdexcept>
+
+#include "ardsim_description/mesh_tools.h"
+#include "ardsim_description/models.h"
+
+namespace ardsim_pose {
+
+void validate(const PoseConfig& c) {
+  if (c.method != "icp" && c.method != "auto" && c.method != "ring" && c.method != "pyramid")
+    throw std::invalid_argument("method = '" + c.method + "' is not allowed: icp, auto, ring or pyramid");
+  if ((c.method == "ring" || c.method == "pyramid") && c.target != ardsim_description::TargetKind::kIss)
+    throw std::invalid_argument("method = '" + c.method +
+                                "' needs target iss (the close-range methods model " +
+                                "the ISS docking adapter)");
+  close_range::validate(c.mode);
+  ardsim_lidar::validate(c.sensor);
+  validate(c.model);
+  validate(c.visibility);
+  validate(c.icp);
+  validate(c.estimator);
+}
+
+std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::TargetKind kind,
+                                                          const ReferenceModelOptions& options) {
+  return std::make_shared<const ReferenceModel>(
+      ardsim_description::rigidStructure(ardsim_description::buildTarget(kind)),
+      ardsim_description::T_target_port(kind), options);
+}
+
+std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config) {
+  validate(config);
+  return makeEstimator(config, buildReferenceModel(config.target, config.model));
+}
+
+std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
+                                             std::shared_ptr<const ReferenceModel> model) {
+  validate(config);
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::make_unique<IcpTracker>(
+      std::move(model), ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
+  std::unique_ptr<MethodSelector> selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp);
+  if (config.target == ardsim_description::TargetKind::kIss) {
+    const close_range::AdapterGeometry geometry = close_range::issAdapterGeometry();
+    methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, config.ring);
+    methods[EstimateMethod::kPyramid] =
+        std::make_unique<close_range::PyramidMethod>(geometry, config.pyramid);
+    if (config.method == "ring") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kRing);
+    if (config.method == "pyramid")
+      selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kPyramid);
+    if (config.method == "auto") {
+      selector = std::make_unique<close_range::ModeSelector>(config.mode, geometry.T_target_port);
+    }
+  }
+  return std::make_unique<PoseEstimator>(config.estimator, std::move(methods), std::move(selector));
+}
+
+}  // namespace ardsim_pose

@@ -1,0 +1,349 @@
+#include "ardsim_pose/icp_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+namespace ardsim_pose {
+
+namespace {
+
+void require(bool ok, const std::string& name, double value, const std::string& allowed) {
+  if (!ok) throw std::invalid_argument(name + " = " + std::to_string(value) + " is out of range: " + allowed);
+}
+
+bool positive(double v) {
+  return std::isfinite(v) && v > 0.0;
+}
+bool fraction(double v) {
+  return std::isfinite(v) && v >= 0.0 && v <= 1.0;
+}
+
+double median(std::vector<double>* values) {
+  if (values->empty()) return 0.0;
+  auto middle = values->begin() + values->size() / 2;
+  std::nth_element(values->begin(), middle, values->end());
+  return *middle;
+}
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+std::string format(const char* pattern, double a, double b = 0.0) {
+  char text[160];
+  std::snprintf(text, sizeof(text), pattern, a, b);
+  return text;
+}
+
+}  // namespace
+
+void validate(const IcpOptions& o) {
+  require(o.max_points >= 50 && o.max_points <= 100000, "icp/max_points", o.max_points, "50 .. 100000");
+  require(o.max_iterations_tracking >= 1 && o.max_iterations_tracking <= 200, "icp/max_iterations_tracking",
+          o.max_iterations_tracking, "1 .. 200");
+  require(o.max_iterations_acquisition >= 1 && o.max_iterations_acquisition <= 500,
+          "icp/max_iterations_acquisition", o.max_iterations_acquisition, "1 .. 500");
+  require(positive(o.gate_min_m), "icp/gate_min_m", o.gate_min_m, "> 0");
+  require(positive(o.gate_tracking_m) && o.gate_tracking_m >= o.gate_min_m, "icp/gate_tracking_m",
+          o.gate_tracking_m, ">= gate_min_m");
+  require(positive(o.gate_acquisition_m) && o.gate_acquisition_m >= o.gate_min_m, "icp/gate_acquisition_m",
+          o.gate_acquisition_m, ">= gate_min_m");
+  require(positive(o.tukey_c), "icp/tukey_c", o.tukey_c, "> 0");
+  require(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
+  require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
+          "> 0");
+  require(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad, "> 0");
+  require(positive(o.revisibility_translation_m), "icp/revisibility_translation_m",
+          o.revisibility_translation_m, "> 0");
+  require(positive(o.revisibility_rotation_rad), "icp/revisibility_rotation_rad", o.revisibility_rotation_rad,
+          "> 0");
+  require(o.min_points >= 6 && o.min_points <= o.max_points, "icp/min_points", o.min_points,
+          "6 .. max_points");
+  require(fraction(o.lost_inlier_fraction), "icp/lost_inlier_fraction", o.lost_inlier_fraction, "0 .. 1");
+  require(fraction(o.degraded_inlier_fraction) && o.degraded_inlier_fraction >= o.lost_inlier_fraction,
+          "icp/degraded_inlier_fraction", o.degraded_inlier_fraction, "lost_inlier_fraction .. 1");
+  require(positive(o.lost_fit_rms_m), "icp/lost_fit_rms_m", o.lost_fit_rms_m, "> 0");
+  require(positive(o.degraded_fit_rms_m) && o.degraded_fit_rms_m <= o.lost_fit_rms_m,
+          "icp/degraded_fit_rms_m", o.degraded_fit_rms_m, "> 0 .. lost_fit_rms_m");
+  require(fraction(o.lost_coverage), "icp/lost_coverage", o.lost_coverage, "0 .. 1");
+  require(fraction(o.degraded_coverage) && o.degraded_coverage >= o.lost_coverage, "icp/degraded_coverage",
+          o.degraded_coverage, "lost_coverage .. 1");
+  require(fraction(o.degraded_condition), "icp/degraded_condition", o.degraded_condition, "0 .. 1");
+  require(positive(o.confirm_translation_m), "icp/confirm_translation_m", o.confirm_translation_m, "> 0");
+  require(positive(o.confirm_rotation_rad), "icp/confirm_rotation_rad", o.confirm_rotation_rad, "> 0");
+  require(positive(o.max_correction_m), "icp/max_correction_m", o.max_correction_m, "> 0");
+  require(positive(o.max_correction_rad), "icp/max_correction_rad", o.max_correction_rad, "> 0");
+}
+
+IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model,
+                       const ardsim_lidar::Intrinsics& intrinsics, const IcpOptions& options,
+                       const VisibilityOptions& visibility)
+    : model_(std::move(model)),
+      intrinsics_(intrinsics),
+      options_(options),
+      visibility_(intrinsics, visibility) {
+  validate(options_);
+  if (!model_) throw std::invalid_argument("IcpTracker: no reference model");
+}
+
+double IcpTracker::coverage() const {
+  // Of the cells where the model is predicted (inside the image), the fraction where the scan has a return
+  // near the predicted depth: a different object, or the right object at a wrong pose, leaves most of them
+  // empty.
+  const std::vector<float>& model_depth = visibility_.modelDepth();
+  int predicted = 0;
+  int confirmed = 0;
+  const double cell_angle = visibility_.cellPx() / intrinsics_.fx;
+  for (std::size_t c = 0; c < model_depth.size(); ++c) {
+    if (!std::isfinite(model_depth[c])) continue;
+    ++predicted;
+    const double tolerance = std::max(0.5, 5.0 * cell_angle * model_depth[c]);
+    if (std::isfinite(scan_depth_[c]) && std::abs(scan_depth_[c] - model_depth[c]) < tolerance) ++confirmed;
+  }
+  return predicted > 0 ? static_cast<double>(confirmed) / predicted : 0.0;
+}
+
+void IcpTracker::alignRange(Eigen::Isometry3d* T) {
+  // A prior's range can be 10 % off: metres at 100 m, more than nearest-point correspondences can pull. Move
+  // the target along the line of sight by the ratio of the median scan depth to the median predicted model
+  // depth, over the cells where both are present (twice: the visible model changes with the range).
+  for (int pass = 0; pass < 2; ++pass) {
+    visibility_.predict(*model_, *T, &visible_);
+    const std::vector<float>& model_depth = visibility_.modelDepth();
+    scratch_.clear();
+    std::vector<double> model_values;
+    for (std::size_t c = 0; c < model_depth.size(); ++c) {
+      if (!std::isfinite(model_depth[c]) || !std::isfinite(scan_depth_[c])) continue;
+      scratch_.push_back(scan_depth_[c]);
+      model_values.push_back(model_depth[c]);
+    }
+    if (scratch_.size() < 20) return;
+    const double ratio = median(&scratch_) / median(&model_values);
+    if (!(ratio > 0.5 && ratio < 2.0)) return;
+    T->translation() *= ratio;
+  }
+}
+
+PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted) {
+  PoseResult result;
+  result.method = EstimateMethod::kIcp;
+  result.T_lidar_target = T_predicted;
+  coverage_ = 0.0;
+  scan_.clear();
+  const bool acquiring = acquiring_;
+  auto lost = [&](const std::string& reason) {
+    result.status = EstimateStatus::kLost;
+    result.reason = reason;
+    result.covariance.setZero();
+    acquiring_ = true;
+    return result;
+  };
+  if (cloud.points.empty()) return lost("empty frame: no points");
+  if (cloud.width != intrinsics_.width || cloud.height != intrinsics_.height ||
+      cloud.points.size() != static_cast<std::size_t>(cloud.width) * cloud.height) {
+    std::ostringstream reason;
+    reason << "frame " << cloud.width << "x" << cloud.height << " with " << cloud.points.size()
+           << " points does not match the sensor (" << intrinsics_.width << "x" << intrinsics_.height << ")";
+    return lost(reason.str());
+  }
+
+  // Valid returns, and the nearest return per visibility cell (for the coverage check).
+  valid_.clear();
+  scan_depth_.assign(static_cast<std::size_t>(visibility_.gridWidth()) * visibility_.gridHeight(),
+                     std::numeric_limits<float>::infinity());
+  for (int v = 0; v < cloud.height; ++v) {
+    for (int u = 0; u < cloud.width; ++u) {
+      const int i = v * cloud.width + u;
+      const Eigen::Vector3f& p = cloud.points[i];
+      if (!p.allFinite() || !(p.z() > 0.0f)) continue;
+      valid_.push_back(i);
+      float& d = scan_depth_[visibility_.cellOfPixel(u, v)];
+      d = std::min(d, p.z());
+    }
+  }
+  if (valid_.empty()) return lost("empty frame: no valid returns");
+  if (static_cast<int>(valid_.size()) < options_.min_points)
+    return lost("too few points: " + std::to_string(valid_.size()) + " valid returns < " +
+                std::to_string(options_.min_points));
+  // Every k-th valid pixel (evenly spread, deterministic), at most max_points.
+  const std::size_t count = std::min<std::size_t>(valid_.size(), options_.max_points);
+  scan_.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) scan_.push_back(cloud.points[valid_[k * valid_.size() / count]]);
+
+  active_ = scan_;
+  Eigen::Isometry3d T = T_predicted;
+  if (acquiring) alignRange(&T);
+  Eigen::Isometry3d T_visibility = T;
+  visibility_.predict(*model_, T, &visible_);
+  double gate = acquiring ? options_.gate_acquisition_m : options_.gate_tracking_m;
+  const int max_iterations =
+      acquiring ? options_.max_iterations_acquisition : options_.max_iterations_tracking;
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double sigma = options_.min_sigma_m;
+  bool converged = false;
+  int iteration = 0;
+  int inliers = 0;
+  double inlier_sq_sum = 0.0;
+  double weight_sum = 0.0;
+  double weighted_sq_sum = 0.0;
+  for (; iteration < max_iterations && !converged; ++iteration) {
+    const Eigen::Isometry3d moved = T_visibility.inverse() * T;
+    if (moved.translation().norm() > options_.revisibility_translation_m ||
+        Eigen::AngleAxisd(moved.linear()).angle() > options_.revisibility_rotation_rad) {
+      visibility_.predict(*model_, T, &visible_);
+      T_visibility = T;
+    }
+    const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
+    const Eigen::Matrix3d R = T.linear();
+    correspondences_.clear();
+    const float gate_sq = static_cast<float>(gate * gate);
+    std::size_t kept = 0;
+    for (const Eigen::Vector3f& s : active_) {
+      float distance_sq = 0.0f;
+      const int j = model_->nearestVisible(T_target_lidar * s, gate_sq, visible_, &distance_sq);
+      if (j < 0) continue;
+      // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
+      // solar arrays, background returns. Searching for it again each iteration is the costliest query.
+      if (!acquiring) active_[kept++] = s;
+      Correspondence c;
+      c.scan = s.cast<double>();
+      c.model = T * model_->points()[j].cast<double>();
+      c.normal = R * model_->normals()[j].cast<double>();
+      c.residual = c.normal.dot(c.scan - c.model);
+      c.distance = std::sqrt(static_cast<double>(distance_sq));
+      correspondences_.push_back(c);
+    }
+    if (!acquiring) active_.resize(kept);
+    if (static_cast<int>(correspondences_.size()) < options_.min_points)
+      return lost("too few correspondences with the model: " + std::to_string(correspondences_.size()) +
+                  " < " + std::to_string(options_.min_points));
+
+    scratch_.clear();
+    for (const Correspondence& c : correspondences_) scratch_.push_back(std::abs(c.residual));
+    sigma = std::max(options_.min_sigma_m, 1.4826 * median(&scratch_));
+    const double limit = options_.tukey_c * sigma;
+    centre.setZero();
+    for (const Correspondence& c : correspondences_) centre += c.model;
+    centre /= static_cast<double>(correspondences_.size());
+
+    // Normal equations of the point-to-plane residual for a twist (v, w) about `centre` (conditioning):
+    // p' = p + w x (p - centre) + v.
+    H.setZero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    inliers = 0;
+    inlier_sq_sum = 0.0;
+    weight_sum = 0.0;
+    weighted_sq_sum = 0.0;
+    for (const Correspondence& c : correspondences_) {
+      const double u = c.residual / limit;
+      if (std::abs(u) >= 1.0) continue;
+      const double w = (1.0 - u * u) * (1.0 - u * u);
+      Eigen::Matrix<double, 6, 1> J;
+      J.head<3>() = c.normal;
+      J.tail<3>() = (c.model - centre).cross(c.normal);
+      H.noalias() += w * J * J.transpose();
+      g.noalias() += w * c.residual * J;
+      ++inliers;
+      inlier_sq_sum += c.residual * c.residual;
+      weight_sum += w;
+      weighted_sq_sum += w * c.residual * c.residual;
+    }
+    if (inliers < options_.min_points)
+      return lost("too few inliers: " + std::to_string(inliers) + " < " +
+                  std::to_string(options_.min_points));
+    const Eigen::Matrix<double, 6, 1> delta = H.ldlt().solve(g);
+    if (!delta.allFinite()) return lost("diverged: singular normal equations");
+    const Eigen::Vector3d v = delta.head<3>();
+    const Eigen::Vector3d w = delta.tail<3>();
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (w.norm() > 0.0) step.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    step.translation() = centre + v - step.linear() * centre;
+    T = step * T;
+    converged = v.norm() < options_.converged_translation_m && w.norm() < options_.converged_rotation_rad;
+
+    scratch_.clear();
+    for (const Correspondence& c : correspondences_) scratch_.push_back(c.distance);
+    gate = std::clamp(4.0 * median(&scratch_), options_.gate_min_m, gate);
+  }
+  result.iterations = iteration;
+  result.points_used = static_cast<int>(scan_.size());
+  result.T_lidar_target = T;
+  result.T_lidar_target.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+  result.fit_rms_m = std::sqrt(inlier_sq_sum / std::max(1, inliers));
+  result.inlier_fraction = static_cast<double>(inliers) / static_cast<double>(scan_.size());
+
+  // Covariance of (v, w) about the centre from the last normal equations, mapped to the target origin's
+  // position and the rotation: delta_origin = v + w x (origin - centre).
+  const double dof = std::max(1.0, weight_sum - 6.0);
+  const double variance = std::max(weighted_sq_sum / dof, options_.min_sigma_m * options_.min_sigma_m);
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Identity();
+  A.block<3, 3>(0, 3) = -skew(T.translation() - centre);
+  const Eigen::Matrix<double, 6, 6> H_inverse = H.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  result.covariance = A * (variance * H_inverse) * A.transpose();
+
+  // Condition of the normal equations with the rotations scaled by the lever arm, so that units compare.
+  double lever_sq = 0.0;
+  for (const Correspondence& c : correspondences_) lever_sq += (c.model - centre).squaredNorm();
+  const double lever = std::sqrt(lever_sq / correspondences_.size());
+  Eigen::Matrix<double, 6, 1> scale;
+  scale << 1, 1, 1, 1.0 / lever, 1.0 / lever, 1.0 / lever;
+  const Eigen::Matrix<double, 6, 6> H_scaled = scale.asDiagonal() * H * scale.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(H_scaled);
+  const double largest = eigen.eigenvalues()(5);
+  const double condition = largest > 0.0 ? eigen.eigenvalues()(0) / largest : 0.0;
+  // Information about the boresight rotation once the other five are free.
+  const Eigen::Matrix<double, 6, 6> scaled_inverse =
+      H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  result.boresight_rotation_observed =
+      largest > 0.0 && 1.0 / scaled_inverse(5, 5) / largest > options_.degraded_condition;
+
+  coverage_ = coverage();
+  const Eigen::Isometry3d correction = T_predicted.inverse() * T;
+  const double correction_m = (T.translation() - T_predicted.translation()).norm();
+  const double correction_rad = Eigen::AngleAxisd(correction.linear()).angle();
+  std::vector<std::string> degraded;
+  if (!acquiring &&
+      (correction_m > options_.max_correction_m || correction_rad > options_.max_correction_rad))
+    return lost(format("diverged: %.2f m / %.2f deg from the prediction", correction_m,
+                       correction_rad * 180.0 / M_PI));
+  if (result.inlier_fraction < options_.lost_inlier_fraction)
+    return lost(format("poor fit: inlier fraction %.2f < %.2f", result.inlier_fraction,
+                       options_.lost_inlier_fraction));
+  if (result.fit_rms_m > options_.lost_fit_rms_m)
+    return lost(format("poor fit: rms %.3f m > %.3f m", result.fit_rms_m, options_.lost_fit_rms_m));
+  if (coverage_ < options_.lost_coverage)
+    return lost(format("model not seen: coverage %.2f < %.2f", coverage_, options_.lost_coverage));
+  if (!converged) degraded.push_back("not converged in " + std::to_string(iteration) + " iterations");
+  if (result.inlier_fraction < options_.degraded_inlier_fraction)
+    degraded.push_back(format("inlier fraction %.2f", result.inlier_fraction));
+  if (result.fit_rms_m > options_.degraded_fit_rms_m)
+    degraded.push_back(format("fit rms %.3f m", result.fit_rms_m));
+  if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
+  if (condition < options_.degraded_condition)
+    degraded.push_back(format("poorly constrained (condition %.1e)", condition));
+  // Acquisition ends when a frame agrees with the one before (its prediction): a local minimum of a single
+  // frame is not reported as TRACKING.
+  if (degraded.empty() && acquiring &&
+      (correction_m > options_.confirm_translation_m || correction_rad > options_.confirm_rotation_rad))
+    degraded.push_back(format("acquiring: %.3f m / %.3f deg from the previous frame", correction_m,
+                              correction_rad * 180.0 / M_PI));
+  if (degraded.empty()) {
+    result.status = EstimateStatus::kTracking;
+    acquiring_ = false;
+  } else {
+    result.status = EstimateStatus::kDegraded;
+    for (const std::string& reason : degraded) result.reason += (result.reason.empty() ? "" : "; ") + reason;
+  }
+  return result;
+}
+
+}  // namespace ardsim_pose

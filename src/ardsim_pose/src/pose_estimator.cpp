@@ -1,0 +1,162 @@
+#include "ardsim_pose/pose_estimator.h"
+
+#include "ardsim_pose/close_range/mode_manager.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ardsim_pose {
+
+namespace {
+
+Eigen::Matrix3d rotationOf(const Eigen::Vector3d& rotation_vector) {
+  const double angle = rotation_vector.norm();
+  if (angle == 0.0) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, rotation_vector / angle).toRotationMatrix();
+}
+
+Eigen::Vector3d rotationVector(const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
+double medianOfValues(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+void validate(const EstimatorOptions& o) {
+  if (o.median_window < 1 || o.median_window > 51 || o.median_window % 2 == 0)
+    throw std::invalid_argument("median_window = " + std::to_string(o.median_window) +
+                                " is out of range: odd, 1 .. 51");
+  if (!(o.velocity_smoothing > 0.0 && o.velocity_smoothing <= 1.0))
+    throw std::invalid_argument("velocity_smoothing = " + std::to_string(o.velocity_smoothing) +
+                                " is out of range: > 0 .. 1");
+  if (!(std::isfinite(o.max_prediction_gap_s) && o.max_prediction_gap_s >= 0.0))
+    throw std::invalid_argument("max_prediction_gap_s = " + std::to_string(o.max_prediction_gap_s) +
+                                " is out of range: >= 0");
+}
+
+PoseEstimator::PoseEstimator(const EstimatorOptions& options, Methods methods,
+                             std::unique_ptr<MethodSelector> selector)
+    : options_(options), methods_(std::move(methods)), selector_(std::move(selector)) {
+  validate(options_);
+  if (methods_.empty()) throw std::invalid_argument("PoseEstimator: no pose methods");
+  if (!selector_) throw std::invalid_argument("PoseEstimator: no method selector");
+}
+
+void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
+  prior_ = T_lidar_target;
+  have_good_ = false;
+  velocity_valid_ = false;
+  velocity_mps_.setZero();
+  angular_velocity_radps_.setZero();
+  have_previous_ = false;
+  recent_.clear();
+  for (auto& method : methods_) method.second->reset();
+  selector_->reset();
+}
+
+Eigen::Isometry3d PoseEstimator::predict(double stamp_s) const {
+  if (!have_good_) return prior_;
+  const double dt = stamp_s - last_good_stamp_s;
+  if (!velocity_valid_ || dt <= 0.0 || dt > options_.max_prediction_gap_s) return last_good_;
+  Eigen::Isometry3d T = last_good_;
+  T.translation() += velocity_mps_ * dt;
+  T.linear() = rotationOf(angular_velocity_radps_ * dt) * last_good_.linear();
+  return T;
+}
+
+void PoseEstimator::updateVelocity(const Eigen::Isometry3d& T, EstimateStatus status, double stamp_s) {
+  const double dt = stamp_s - last_good_stamp_s;
+  // Only TRACKING estimates in a row: the jumps of an acquisition are no motion.
+  if (!have_good_ || !last_good_tracking_ || status != EstimateStatus::kTracking || dt <= 0.0 ||
+      dt > options_.max_prediction_gap_s) {
+    velocity_valid_ = false;
+    return;
+  }
+  const Eigen::Vector3d v = (T.translation() - last_good_.translation()) / dt;
+  const Eigen::Vector3d w = rotationVector(T.linear() * last_good_.linear().transpose()) / dt;
+  const double a = velocity_valid_ ? options_.velocity_smoothing : 1.0;
+  velocity_mps_ = a * v + (1.0 - a) * velocity_mps_;
+  angular_velocity_radps_ = a * w + (1.0 - a) * angular_velocity_radps_;
+  velocity_valid_ = true;
+}
+
+Eigen::Isometry3d PoseEstimator::medianOf(const std::deque<Eigen::Isometry3d>& poses) const {
+  // Per axis: the median position, and the median rotation vector relative to the newest attitude.
+  const Eigen::Isometry3d& newest = poses.back();
+  Eigen::Isometry3d out = newest;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> position;
+    for (const Eigen::Isometry3d& T : poses) position.push_back(T.translation()[axis]);
+    out.translation()[axis] = medianOfValues(position);
+  }
+  Eigen::Vector3d median_rotation;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> rotation;
+    for (const Eigen::Isometry3d& T : poses)
+      rotation.push_back(rotationVector(T.linear() * newest.linear().transpose())[axis]);
+    median_rotation[axis] = medianOfValues(rotation);
+  }
+  out.linear() = rotationOf(median_rotation) * newest.linear();
+  return out;
+}
+
+EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
+  const auto start = std::chrono::steady_clock::now();
+  EstimatorOutput out;
+  SelectionInput input;
+  input.cloud = &cloud;
+  input.T_lidar_target_predicted = predict(cloud.stamp_s);
+  input.previous = have_previous_ ? &previous_ : nullptr;
+  const EstimateMethod chosen = selector_->select(input);
+  const auto method = methods_.find(chosen);
+  if (method == methods_.end()) {
+    out.result.reason = "the method selector chose a method this estimator does not have";
+    out.result.T_lidar_target = input.T_lidar_target_predicted;
+  } else {
+    out.result = method->second->estimate(cloud, input.T_lidar_target_predicted);
+    // A hand-over between methods: the old method's estimate blended into the new one's over a few frames.
+    EstimateMethod from = chosen;
+    double weight = 1.0;
+    const auto old = selector_->blending(&from, &weight) ? methods_.find(from) : methods_.end();
+    if (old != methods_.end() && from != chosen && out.result.status != EstimateStatus::kLost) {
+      const PoseResult previous_method = old->second->estimate(cloud, input.T_lidar_target_predicted);
+      if (previous_method.status != EstimateStatus::kLost) {
+        out.result.T_lidar_target =
+            close_range::blendPoses(previous_method.T_lidar_target, out.result.T_lidar_target, weight);
+      }
+    }
+  }
+  previous_ = out.result;
+  have_previous_ = true;
+  if (out.result.status != EstimateStatus::kLost) {
+    updateVelocity(out.result.T_lidar_target, out.result.status, cloud.stamp_s);
+    last_good_tracking_ = out.result.status == EstimateStatus::kTracking;
+    last_good_ = out.result.T_lidar_target;
+    last_good_stamp_s = cloud.stamp_s;
+    have_good_ = true;
+    if (options_.median_filter) {
+      recent_.push_back(out.result.T_lidar_target);
+      while (static_cast<int>(recent_.size()) > options_.median_window) recent_.pop_front();
+      out.result.T_lidar_target = medianOf(recent_);
+    }
+  } else {
+    recent_.clear();  // the filter restarts with the next good estimate
+  }
+  out.velocity_mps = velocity_mps_;
+  out.angular_velocity_radps = angular_velocity_radps_;
+  out.velocity_valid = velocity_valid_ && out.result.status != EstimateStatus::kLost;
+  out.compute_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace ardsim_pose

@@ -1,0 +1,127 @@
+#!/usr/bin/env python3
+"""Interface test of the pose node/nodelet: drives the lidar with truth steps (the chaser on the ISS docking axis,
+its port 29 m out) and publishes bad clouds of its own; every cloud must be answered by exactly one pose/estimate
+with its stamp, and every estimate by one pose/error."""
+import math
+import struct
+import subprocess
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from ardsim_msgs.msg import PoseError, PoseEstimate
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import PointCloud2, PointField
+
+TARGET_ECI = (6.778e6, 1.25e5, -2.5e5)
+# ISS port at (14.5, 0, 4.5) in the target frame, x out of the port; the chaser faces it (yaw 180 deg) with its
+# port (3 m ahead of its centre of mass) 29 m out.
+CHASER_OFFSET = (14.5 + 29.0 + 3.0, 0.0, 4.5)
+FACING_TARGET = (0.0, 0.0, 1.0, 0.0)
+WAIT_S = 90.0
+
+
+def odometry(stamp, child, position, orientation):
+    msg = Odometry()
+    msg.header.stamp = stamp
+    msg.header.frame_id = 'eci'
+    msg.child_frame_id = child
+    msg.pose.pose.position.x, msg.pose.pose.position.y, msg.pose.pose.position.z = position
+    o = msg.pose.pose.orientation
+    o.x, o.y, o.z, o.w = orientation
+    return msg
+
+
+def cloud(stamp, width, height, value):
+    msg = PointCloud2()
+    msg.header.stamp = stamp
+    msg.header.frame_id = 'lidar_optical'
+    msg.width, msg.height = width, height
+    msg.fields = [PointField(n, 4 * i, PointField.FLOAT32, 1) for i, n in enumerate(('x', 'y', 'z', 'intensity'))]
+    msg.point_step = 16
+    msg.row_step = 16 * width
+    msg.data = struct.pack('<4f', value, value, value, value) * (width * height)
+    return msg
+
+
+class PoseInterfaceTest(unittest.TestCase):
+    def setUp(self):
+        self.lock = threading.Lock()
+        self.estimates = []
+        self.errors = []
+        self.subscribers = [rospy.Subscriber('pose/estimate', PoseEstimate, self.store, self.estimates, queue_size=50),
+                            rospy.Subscriber('pose/error', PoseError, self.store, self.errors, queue_size=50)]
+        self.clock = rospy.Publisher('/clock', Clock, queue_size=10, latch=True)
+        self.target = rospy.Publisher('truth/target/odom', Odometry, queue_size=10)
+        self.chaser = rospy.Publisher('truth/chaser/odom', Odometry, queue_size=10)
+        self.points = rospy.Publisher('lidar/points', PointCloud2, queue_size=10)
+        self.wait_for(lambda: self.target.get_num_connections() >= 2 and self.chaser.get_num_connections() >= 2 and
+                      self.points.get_num_connections() > 0 and
+                      all(s.get_num_connections() > 0 for s in self.subscribers), 'the nodes to connect')
+
+    def store(self, msg, where):
+        with self.lock:
+            where.append(msg)
+
+    def wait_for(self, condition, what):
+        deadline = time.monotonic() + WAIT_S
+        while not condition():
+            if rospy.is_shutdown() or time.monotonic() > deadline:
+                self.fail('timed out waiting for ' + what)
+            time.sleep(0.02)
+
+    def answer(self, seconds, publish):
+        count = len(self.estimates) + 1
+        stamp = rospy.Time.from_sec(seconds)
+        self.clock.publish(Clock(clock=stamp))
+        publish(stamp)
+        self.wait_for(lambda: len(self.estimates) >= count, 'the estimate at t = %g' % seconds)
+        estimate = self.estimates[-1]
+        self.assertEqual(len(self.estimates), count, 'one estimate per cloud')
+        self.assertEqual(estimate.header.stamp, stamp)
+        self.assertEqual(estimate.header.frame_id, 'lidar_optical')
+        return estimate
+
+    def truth_step(self, stamp):
+        position = tuple(t + o for t, o in zip(TARGET_ECI, CHASER_OFFSET))
+        self.target.publish(odometry(stamp, 'target', TARGET_ECI, (0.0, 0.0, 0.0, 1.0)))
+        self.chaser.publish(odometry(stamp, 'chaser', position, FACING_TARGET))
+
+    def test_one_estimate_per_cloud(self):
+        for k in range(1, 4):
+            estimate = self.answer(float(k), self.truth_step)
+            self.assertNotEqual(estimate.status, PoseEstimate.STATUS_LOST, estimate.reason)
+            self.assertEqual(estimate.method, PoseEstimate.METHOD_ICP)
+        self.wait_for(lambda: len(self.errors) >= 3, 'three pose errors')
+        error = self.errors[-1]
+        self.assertEqual(error.header.stamp, rospy.Time.from_sec(3.0))
+        self.assertLess(error.port_position_error_m, 0.05)
+        self.assertLess(error.attitude_error_rad, math.radians(0.1))
+        self.assertAlmostEqual(error.range_m, 30.0, delta=0.01)
+
+        nan_estimate = self.answer(4.0, lambda s: self.points.publish(cloud(s, 256, 256, float('nan'))))
+        self.assertEqual(nan_estimate.status, PoseEstimate.STATUS_LOST)
+        self.assertIn('empty', nan_estimate.reason)
+        empty_estimate = self.answer(5.0, lambda s: self.points.publish(cloud(s, 0, 0, 0.0)))
+        self.assertEqual(empty_estimate.status, PoseEstimate.STATUS_LOST)
+        unorganized = self.answer(6.0, lambda s: self.points.publish(cloud(s, 100, 1, 1.0)))
+        self.assertEqual(unorganized.status, PoseEstimate.STATUS_LOST)
+        self.assertIn('organized', unorganized.reason)
+
+        # The node kept running and tracks again.
+        estimate = self.answer(7.0, self.truth_step)
+        self.assertNotEqual(estimate.status, PoseEstimate.STATUS_LOST, estimate.reason)
+
+    def test_bad_parameter_stops_the_node_with_a_clear_error(self):
+        result = subprocess.run(['rosrun', 'ardsim_pose', 'pose_node', '__name:=bad_pose', '_icp/max_points:=3'],
+                                capture_output=True, text=True, timeout=120)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn('icp/max_points', result.stdout + result.stderr)
+
+
+if __name__ == '__main__':
+    rospy.init_node('pose_node_test')
+    rostest.rosrun('ardsim_pose', 'pose_node_test', PoseInterfaceTest)
