@@ -1,6 +1,7 @@
 #include "ardsim_pose/close_range/pyramid.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
@@ -75,10 +76,50 @@ void PyramidMethod::cellFeatures(const Eigen::Isometry3d& T_port_lidar, PyramidC
   cell->behind_fraction = behind / n;
 }
 
+Eigen::Isometry3d PyramidMethod::alignRange(const Eigen::Isometry3d& T_lidar_port_predicted) const {
+  // Level 0: along the predicted port axis, the depth histogram of the points inside the ring's annulus peaks
+  // at the ring's face; move the prediction there (a fast approach outruns the band of the cell features).
+  const AdapterGeometry& g = fitter_.geometry();
+  // Only while the whole annulus is in view (beyond ~3.4 m); nearer, the passage's wall and the petals fill
+  // that window too.
+  const double half_view =
+      std::tan(0.5 * options_.fit.pixel_pitch_rad * std::min(frame_.width, frame_.height));
+  if (T_lidar_port_predicted.translation().z() * half_view < g.ring_outer_radius_m)
+    return T_lidar_port_predicted;
+  const Eigen::Isometry3d T_port_lidar = T_lidar_port_predicted.inverse();
+  constexpr double kBin = 0.01, kHalfSpan = 0.5;
+  constexpr int kBins = static_cast<int>(2 * kHalfSpan / kBin);
+  std::array<int, kBins> histogram{};
+  const double r_in = g.ring_inner_radius_m + 0.02, r_out = g.ring_outer_radius_m - 0.02;
+  for (int i = 0; i < frame_.width * frame_.height; ++i) {
+    if (!frame_.isValid(i)) continue;
+    const Eigen::Vector3d q = T_port_lidar * frame_.points[i].cast<double>();
+    const double r2 = q.y() * q.y() + q.z() * q.z();
+    if (r2 < r_in * r_in || r2 > r_out * r_out) continue;
+    const int bin = static_cast<int>(std::floor((q.x() + kHalfSpan) / kBin));
+    if (bin >= 0 && bin < kBins) ++histogram[bin];
+  }
+  int best = kBins / 2, best_count = 0;
+  for (int bin = 1; bin + 1 < kBins; ++bin) {
+    const int count = histogram[bin - 1] + histogram[bin] + histogram[bin + 1];
+    if (count > best_count) {
+      best_count = count;
+      best = bin;
+    }
+  }
+  if (best_count < options_.fit.min_edge_points) return T_lidar_port_predicted;
+  const double shift = (best + 0.5) * kBin - kHalfSpan;  // ring face at port x = shift
+  Eigen::Isometry3d T = T_lidar_port_predicted;
+  T.translation() += shift * T.linear().col(0);
+  return T;
+}
+
 PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
                                    const Eigen::Isometry3d& T_lidar_target_predicted) {
   prepareFrame(cloud, options_.fit, &frame_);
-  const Eigen::Isometry3d T_lidar_port_prior = T_lidar_target_predicted * fitter_.geometry().T_target_port;
+  const Eigen::Isometry3d T_lidar_port_predicted =
+      T_lidar_target_predicted * fitter_.geometry().T_target_port;
+  const Eigen::Isometry3d T_lidar_port_prior = alignRange(T_lidar_port_predicted);
   const Eigen::Isometry3d T_port_lidar = T_lidar_port_prior.inverse();
   const double predicted_range = T_lidar_port_prior.translation().norm();
   const double cell_area = frame_.width * frame_.height / 9.0;

@@ -8,8 +8,11 @@
 // plane and between the ring's inner and outer radius (with lateral_margin_m); "behind": more than behind_m
 // behind that plane.
 //
-// Level 1, coarse cells (~85 x 85 pixels). Features: valid-pixel count, mean range, range slopes d range / du
-// and d range / dv (least squares over the cell), the cell's plane normal, ring-band fraction.
+// Level 0 aligns the prediction in range: the depth histogram (+-0.5 m) of the points inside the ring's
+// annulus around the predicted axis peaks at the ring's face (a fast approach outruns the band otherwise);
+// only while the whole annulus is in view. Level 1, coarse cells (~85 x 85 pixels). Features: valid-pixel
+// count, mean range, range slopes d range / du and d range / dv (least squares over the cell), the cell's
+// plane normal, ring-band fraction.
 //   promising: valid fraction >= min_fill, ring-band fraction >= min_ring_fraction_coarse, and a mean range
 //   within
 //              max_range_offset_m of the predicted port range (a cell of the background modules is not).
@@ -77,6 +80,7 @@ class PyramidMethod : public PoseMethod {
 
  private:
   void cellFeatures(const Eigen::Isometry3d& T_port_lidar, PyramidCell* cell) const;
+  Eigen::Isometry3d alignRange(const Eigen::Isometry3d& T_lidar_port_predicted) const;
 
   PyramidOptions options_;
   AdapterFitter fitter_;
