@@ -619,6 +619,13 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
     boresight = nearestBranch(cross_angle, M_PI / 2.0, prior_angle);
   }
   result.boresight_rotation_observed = r.report.petals || r.report.cross_angle;
+  // Tracking: a measurement close to the prediction only pulls it part of the way (the angle changes slowly,
+  // the petals' centroids are noisy at several metres); a far one (a new prior, a hand-over) is taken as it
+  // is.
+  if (result.boresight_rotation_observed &&
+      std::abs(wrapPi(boresight - prior_angle)) < options_.boresight_gate_deg * kDeg) {
+    boresight = prior_angle + options_.boresight_gain * wrapPi(boresight - prior_angle);
+  }
 
   // 7. The pose.
   Eigen::Isometry3d T_lidar_port = Eigen::Isometry3d::Identity();

@@ -59,7 +59,10 @@ struct AdapterFitOptions {
       0.03;                   // fitted inner radius within this of the model, or the circle is rejected
   int min_cross_points = 20;  // cross-face points for the lateral position and the boresight angle
   int min_petal_points = 12;
-  double min_resultant = 0.6;  // circular concentration of the petals' angles to count as observed
+  double boresight_gain =
+      0.3;  // a boresight measurement within the gate of the prediction moves it this much
+  double boresight_gate_deg = 1.5;  // beyond: the measurement is taken as it is
+  double min_resultant = 0.6;       // circular concentration of the petals' angles to count as observed
   double max_step_from_prediction_m = 0.5;  // a larger jump from the prediction is not trusted: LOST
   double max_tilt_from_prediction_deg = 10.0;
 };
