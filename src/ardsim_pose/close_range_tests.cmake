@@ -11,7 +11,7 @@ target_link_libraries(pose_close_range_make_golden ${PROJECT_NAME} ${ardsim_lida
 
 if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_pose_close_range test/close_range/test_close_range.cpp test/close_range/test_mode_manager.cpp
-                   test/close_range/test_golden.cpp
+                   test/close_range/test_golden.cpp test/close_range/test_handover.cpp
                    WORKING_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR})
   target_link_libraries(test_pose_close_range ${PROJECT_NAME} ${ardsim_lidar_LIBRARIES} ${OpenCV_LIBS}
                         ${GTEST_MAIN_LIBRARIES})
