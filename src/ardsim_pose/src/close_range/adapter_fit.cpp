@@ -163,11 +163,15 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
   double d = *offset;
   const double sigma = options_.range_sigma_m;
   const double rejects[3] = {2.0 * options_.plane_band_m, 4.0 * sigma, 3.0 * sigma};
-  for (double reject : rejects) {
+  for (int pass = 0; pass < 3; ++pass) {
+    const double reject = rejects[pass];
+    // The first two passes only bring the plane near: every 4th point; the last one all.
+    const std::size_t step = pass < 2 && points.size() > 4u * options_.min_plane_points ? 4 : 1;
     std::array<FaceSums, kFaces> faces;
     double sum_sq = 0.0;
     int inliers = 0;
-    for (const PlanePoint& pp : points) {
+    for (std::size_t k = 0; k < points.size(); k += step) {
+      const PlanePoint& pp = points[k];
       const double residual = n.dot(pp.p) - d - pp.face_x;
       if (std::abs(residual) > reject) continue;
       FaceSums& f = faces[pp.face];
@@ -178,7 +182,7 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
       sum_sq += residual * residual;
       ++inliers;
     }
-    if (inliers < options_.min_plane_points) return false;
+    if (inliers * static_cast<int>(step) < options_.min_plane_points) return false;
     *rms = std::sqrt(sum_sq / inliers);
     *used = inliers;
     for (int step = 0; step < 3; ++step) {

@@ -16,8 +16,15 @@ struct ClusterMetrics {
 };
 
 // Scores one cluster against the ring's criteria (ring_detector.h); false as soon as one fails.
-bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& members, const std::vector<int>& label,
-                  int cluster, const RingDetectorOptions& options, ClusterMetrics* m) {
+bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& all_members,
+                  const std::vector<int>& label, int cluster, const RingDetectorOptions& options,
+                  ClusterMetrics* m) {
+  // The metrics are statistics over the cluster: a spread sample of at most ~2000 of its pixels (in growth
+  // order) is enough and keeps the cost per cluster bounded.
+  const std::size_t step = std::max<std::size_t>(1, all_members.size() / 2000);
+  std::vector<int> members;
+  members.reserve(all_members.size() / step + 1);
+  for (std::size_t k = 0; k < all_members.size(); k += step) members.push_back(all_members[k]);
   // Plane of the cluster, twice: the second time without the members far from the first plane (a cluster can
   // leak onto a steep surface next to the ring, the passage's wall).
   Eigen::Vector3d mean = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();
@@ -34,7 +41,7 @@ bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& members, c
       scatter += p * p.transpose();
       n += 1.0;
     }
-    if (n * options.stride * options.stride < options.min_cluster_pixels) return false;
+    if (n * options.stride * options.stride * step < options.min_cluster_pixels) return false;
     mean = sum / n;
     eig.compute(scatter / n - mean * mean.transpose());
     normal = eig.eigenvectors().col(0);
