@@ -8,8 +8,13 @@
 namespace ardsim_pose {
 
 void validate(const PoseConfig& c) {
-  if (c.method != "icp" && c.method != "auto")
-    throw std::invalid_argument("method = '" + c.method + "' is not allowed: icp or auto");
+  if (c.method != "icp" && c.method != "auto" && c.method != "ring" && c.method != "pyramid")
+    throw std::invalid_argument("method = '" + c.method + "' is not allowed: icp, auto, ring or pyramid");
+  if ((c.method == "ring" || c.method == "pyramid") && c.target != ardsim_description::TargetKind::kIss)
+    throw std::invalid_argument("method = '" + c.method +
+                                "' needs target iss (the close-range methods model " +
+                                "the ISS docking adapter)");
+  close_range::validate(c.mode);
   ardsim_lidar::validate(c.sensor);
   validate(c.model);
   validate(c.visibility);
@@ -35,10 +40,20 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
   PoseEstimator::Methods methods;
   methods[EstimateMethod::kIcp] = std::make_unique<IcpTracker>(
       std::move(model), ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
-  // Both "icp" and "auto" select ICP while it is the only method; the close-range mode manager becomes the
-  // "auto" selector when its methods join the map.
-  return std::make_unique<PoseEstimator>(config.estimator, std::move(methods),
-                                         std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
+  std::unique_ptr<MethodSelector> selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp);
+  if (config.target == ardsim_description::TargetKind::kIss) {
+    const close_range::AdapterGeometry geometry = close_range::issAdapterGeometry();
+    methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, config.ring);
+    methods[EstimateMethod::kPyramid] =
+        std::make_unique<close_range::PyramidMethod>(geometry, config.pyramid);
+    if (config.method == "ring") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kRing);
+    if (config.method == "pyramid")
+      selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kPyramid);
+    if (config.method == "auto") {
+      selector = std::make_unique<close_range::ModeSelector>(config.mode, geometry.T_target_port);
+    }
+  }
+  return std::make_unique<PoseEstimator>(config.estimator, std::move(methods), std::move(selector));
 }
 
 }  // namespace ardsim_pose

@@ -1,5 +1,7 @@
 #include "ardsim_pose/pose_estimator.h"
 
+#include "ardsim_pose/close_range/mode_manager.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -121,6 +123,17 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
     out.result.T_lidar_target = input.T_lidar_target_predicted;
   } else {
     out.result = method->second->estimate(cloud, input.T_lidar_target_predicted);
+    // A hand-over between methods: the old method's estimate blended into the new one's over a few frames.
+    EstimateMethod from = chosen;
+    double weight = 1.0;
+    const auto old = selector_->blending(&from, &weight) ? methods_.find(from) : methods_.end();
+    if (old != methods_.end() && from != chosen && out.result.status != EstimateStatus::kLost) {
+      const PoseResult previous_method = old->second->estimate(cloud, input.T_lidar_target_predicted);
+      if (previous_method.status != EstimateStatus::kLost) {
+        out.result.T_lidar_target =
+            close_range::blendPoses(previous_method.T_lidar_target, out.result.T_lidar_target, weight);
+      }
+    }
   }
   previous_ = out.result;
   have_previous_ = true;

@@ -8,6 +8,9 @@
 
 #include "ardsim_description/frames.h"
 #include "ardsim_lidar/sensor.h"
+#include "ardsim_pose/close_range/mode_manager.h"
+#include "ardsim_pose/close_range/pyramid.h"
+#include "ardsim_pose/close_range/ring_detector.h"
 #include "ardsim_pose/icp_tracker.h"
 #include "ardsim_pose/pose_estimator.h"
 #include "ardsim_pose/reference_model.h"
@@ -17,12 +20,16 @@ namespace ardsim_pose {
 struct PoseConfig {
   ardsim_description::TargetKind target = ardsim_description::TargetKind::kIss;
   ardsim_lidar::SensorOptions sensor;  // width, height and fov_deg must match the lidar's
-  // "icp": ICP every frame. "auto": the default method selector (ICP while it is the only method).
+  // "icp", "ring", "pyramid": that method every frame. "auto": the close-range mode manager (ICP far out, the
+  // close-range method near; ICP only for targets without the docking adapter's close-range model, Hubble).
   std::string method = "icp";
   ReferenceModelOptions model;
   VisibilityOptions visibility;
   IcpOptions icp;
   EstimatorOptions estimator;
+  close_range::RingDetectorOptions ring;
+  close_range::PyramidOptions pyramid;
+  close_range::ModeManagerOptions mode;
 };
 
 // Throws std::invalid_argument naming the option, its value and the allowed values.

@@ -25,6 +25,10 @@ class MethodSelector {
   virtual ~MethodSelector() = default;
   // One of the estimator's methods (a key of its method map).
   virtual EstimateMethod select(const SelectionInput& input) = 0;
+  // After select: whether the estimate is to be blended from another method's (run on the same frame and
+  // prediction) into the selected one's, and the selected one's weight (0..1); the output then does not jump
+  // at a hand-over.
+  virtual bool blending(EstimateMethod* /*from*/, double* /*weight*/) const { return false; }
   virtual void reset() {}
 };
 

@@ -1,0 +1,210 @@
+#include "ardsim_pose/close_range/pyramid.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+namespace ardsim_pose {
+namespace close_range {
+
+namespace {
+
+// Bounds of part k of n equal parts of [begin, end).
+int split(int begin, int end, int k, int n) {
+  return begin + (end - begin) * k / n;
+}
+
+}  // namespace
+
+PyramidMethod::PyramidMethod(const AdapterGeometry& geometry, const PyramidOptions& options)
+    : options_(options), fitter_(geometry, options.fit) {}
+
+void PyramidMethod::cellFeatures(const Eigen::Isometry3d& T_port_lidar, PyramidCell* cell) const {
+  const AdapterGeometry& g = fitter_.geometry();
+  double s_r = 0, s_u = 0, s_v = 0, s_uu = 0, s_uv = 0, s_vv = 0, s_ur = 0, s_vr = 0;
+  Eigen::Vector3d s_p = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d s_pp = Eigen::Matrix3d::Zero();
+  int count = 0, ring = 0, behind = 0;
+  for (int v = cell->v0; v < cell->v1; ++v) {
+    for (int u = cell->u0; u < cell->u1; ++u) {
+      const int i = v * frame_.width + u;
+      if (!frame_.isValid(i)) continue;
+      const double r = frame_.range_m[i];
+      const Eigen::Vector3d p = frame_.points[i].cast<double>();
+      ++count;
+      s_r += r;
+      s_u += u;
+      s_v += v;
+      s_uu += double(u) * u;
+      s_uv += double(u) * v;
+      s_vv += double(v) * v;
+      s_ur += u * r;
+      s_vr += v * r;
+      s_p += p;
+      s_pp += p * p.transpose();
+      const Eigen::Vector3d q = T_port_lidar * p;
+      const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
+      if (std::abs(q.x()) < options_.ring_band_m &&
+          radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
+          radius < g.ring_outer_radius_m + options_.lateral_margin_m) {
+        ++ring;
+      } else if (q.x() < -options_.behind_m) {
+        ++behind;
+      }
+    }
+  }
+  cell->count = count;
+  if (count < options_.min_cell_pixels) return;
+  const double n = count;
+  cell->mean_range_m = s_r / n;
+  // Range slopes: least squares r = a + slope_u (u - mean u) + slope_v (v - mean v).
+  Eigen::Matrix2d A;
+  A << s_uu - s_u * s_u / n, s_uv - s_u * s_v / n, s_uv - s_u * s_v / n, s_vv - s_v * s_v / n;
+  const Eigen::Vector2d b(s_ur - s_u * s_r / n, s_vr - s_v * s_r / n);
+  const Eigen::Vector2d slope = A.ldlt().solve(b);
+  cell->slope_u = slope(0);
+  cell->slope_v = slope(1);
+  const Eigen::Vector3d mean = s_p / n;
+  const Eigen::Matrix3d cov = s_pp / n - mean * mean.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  cell->normal = eig.eigenvectors().col(0);
+  if (cell->normal.z() > 0.0) cell->normal = -cell->normal;
+  cell->rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
+  cell->ring_fraction = ring / n;
+  cell->behind_fraction = behind / n;
+}
+
+Eigen::Isometry3d PyramidMethod::alignRange(const Eigen::Isometry3d& T_lidar_port_predicted) const {
+  // Level 0: along the predicted port axis, the depth histogram of the points inside the ring's annulus peaks
+  // at the ring's face; move the prediction there (a fast approach outruns the band of the cell features).
+  const AdapterGeometry& g = fitter_.geometry();
+  // Only while the whole annulus is in view (beyond ~3.4 m); nearer, the passage's wall and the petals fill
+  // that window too.
+  const double half_view =
+      std::tan(0.5 * options_.fit.pixel_pitch_rad * std::min(frame_.width, frame_.height));
+  if (T_lidar_port_predicted.translation().z() * half_view < g.ring_outer_radius_m)
+    return T_lidar_port_predicted;
+  const Eigen::Isometry3d T_port_lidar = T_lidar_port_predicted.inverse();
+  constexpr double kBin = 0.01, kHalfSpan = 0.5;
+  constexpr int kBins = static_cast<int>(2 * kHalfSpan / kBin);
+  std::array<int, kBins> histogram{};
+  const double r_in = g.ring_inner_radius_m + 0.02, r_out = g.ring_outer_radius_m - 0.02;
+  for (int i = 0; i < frame_.width * frame_.height; ++i) {
+    if (!frame_.isValid(i)) continue;
+    const Eigen::Vector3d q = T_port_lidar * frame_.points[i].cast<double>();
+    const double r2 = q.y() * q.y() + q.z() * q.z();
+    if (r2 < r_in * r_in || r2 > r_out * r_out) continue;
+    const int bin = static_cast<int>(std::floor((q.x() + kHalfSpan) / kBin));
+    if (bin >= 0 && bin < kBins) ++histogram[bin];
+  }
+  int best = kBins / 2, best_count = 0;
+  for (int bin = 1; bin + 1 < kBins; ++bin) {
+    const int count = histogram[bin - 1] + histogram[bin] + histogram[bin + 1];
+    if (count > best_count) {
+      best_count = count;
+      best = bin;
+    }
+  }
+  if (best_count < options_.fit.min_edge_points) return T_lidar_port_predicted;
+  const double shift = (best + 0.5) * kBin - kHalfSpan;  // ring face at port x = shift
+  Eigen::Isometry3d T = T_lidar_port_predicted;
+  T.translation() += shift * T.linear().col(0);
+  return T;
+}
+
+PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
+                                   const Eigen::Isometry3d& T_lidar_target_predicted) {
+  prepareFrame(cloud, options_.fit, &frame_);
+  const Eigen::Isometry3d T_lidar_port_predicted =
+      T_lidar_target_predicted * fitter_.geometry().T_target_port;
+  const Eigen::Isometry3d T_lidar_port_prior = alignRange(T_lidar_port_predicted);
+  const Eigen::Isometry3d T_port_lidar = T_lidar_port_prior.inverse();
+  const double predicted_range = T_lidar_port_prior.translation().norm();
+  const double cell_area = frame_.width * frame_.height / 9.0;
+
+  // Level 1.
+  fine_.clear();
+  for (int k = 0; k < 9; ++k) {
+    PyramidCell& cell = coarse_[k];
+    cell = PyramidCell();
+    cell.u0 = split(0, frame_.width, k % 3, 3);
+    cell.u1 = split(0, frame_.width, k % 3 + 1, 3);
+    cell.v0 = split(0, frame_.height, k / 3, 3);
+    cell.v1 = split(0, frame_.height, k / 3 + 1, 3);
+    cellFeatures(T_port_lidar, &cell);
+    if (cell.count >= options_.min_fill * cell_area &&
+        cell.ring_fraction >= options_.min_ring_fraction_coarse &&
+        std::abs(cell.mean_range_m - predicted_range) <= options_.max_range_offset_m) {
+      cell.verdict = PyramidCell::Verdict::kPromising;
+    }
+  }
+
+  // Level 2.
+  std::vector<Eigen::Vector3d> candidate_normals;
+  for (const PyramidCell& coarse : coarse_) {
+    if (coarse.verdict != PyramidCell::Verdict::kPromising) continue;
+    for (int k = 0; k < 9; ++k) {
+      PyramidCell cell;
+      cell.u0 = split(coarse.u0, coarse.u1, k % 3, 3);
+      cell.u1 = split(coarse.u0, coarse.u1, k % 3 + 1, 3);
+      cell.v0 = split(coarse.v0, coarse.v1, k / 3, 3);
+      cell.v1 = split(coarse.v0, coarse.v1, k / 3 + 1, 3);
+      cellFeatures(T_port_lidar, &cell);
+      if (cell.count < options_.min_cell_pixels) {
+        fine_.push_back(cell);
+        continue;
+      }
+      if (cell.ring_fraction >= options_.min_face_fraction && cell.rms_m <= options_.max_cell_rms_m) {
+        cell.verdict = PyramidCell::Verdict::kFace;
+        candidate_normals.push_back(cell.normal);
+      } else if (cell.ring_fraction >= options_.min_edge_fraction &&
+                 cell.behind_fraction >= options_.min_edge_fraction) {
+        cell.verdict = PyramidCell::Verdict::kEdge;
+      }
+      fine_.push_back(cell);
+    }
+  }
+  // Consensus normal of the face cells: the component-wise median.
+  Eigen::Vector3d consensus = T_lidar_port_prior.linear().col(0);
+  if (!candidate_normals.empty()) {
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<double> values;
+      for (const Eigen::Vector3d& normal : candidate_normals) values.push_back(normal(axis));
+      std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+      consensus(axis) = values[values.size() / 2];
+    }
+    consensus.normalize();
+  }
+  const double max_cos = std::cos(options_.max_normal_deviation_deg * M_PI / 180.0);
+  ring_pixels_.clear();
+  const AdapterGeometry& g = fitter_.geometry();
+  for (PyramidCell& cell : fine_) {
+    if (cell.verdict == PyramidCell::Verdict::kFace && cell.normal.dot(consensus) < max_cos) {
+      cell.verdict = PyramidCell::Verdict::kRejected;
+    }
+    if (cell.verdict != PyramidCell::Verdict::kFace && cell.verdict != PyramidCell::Verdict::kEdge) continue;
+    for (int v = cell.v0; v < cell.v1; ++v) {
+      for (int u = cell.u0; u < cell.u1; ++u) {
+        const int i = v * frame_.width + u;
+        if (!frame_.isValid(i)) continue;
+        const Eigen::Vector3d q = T_port_lidar * frame_.points[i].cast<double>();
+        const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
+        if (std::abs(q.x()) < options_.ring_band_m &&
+            radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
+            radius < g.ring_outer_radius_m + options_.lateral_margin_m) {
+          ring_pixels_.push_back(i);
+        }
+      }
+    }
+  }
+  // Too few passing cells (the ring only a few pixels wide, far out, or leaving the view): the back end
+  // labels the ring from the prediction instead.
+  if (static_cast<int>(ring_pixels_.size()) < options_.fit.min_plane_points) ring_pixels_.clear();
+  return fitter_.fit(frame_, ring_pixels_, T_lidar_port_prior, T_lidar_port_prior, EstimateMethod::kPyramid,
+                     &report_);
+}
+
+}  // namespace close_range
+}  // namespace ardsim_pose

@@ -1,0 +1,199 @@
+// The close-range methods on rendered frames of the ISS docking adapter (issue 5 goals).
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "ardsim_pose/close_range/pyramid.h"
+#include "ardsim_pose/close_range/ring_detector.h"
+#include "rendering.h"
+
+namespace ardsim_pose {
+namespace close_range {
+namespace {
+
+using testing::ApproachState;
+using testing::IssRenderer;
+using testing::PortError;
+
+// The prediction handed to a method: the truth disturbed as a previous estimate or ICP's would be.
+Eigen::Isometry3d predictionFrom(ApproachState s) {
+  s.lateral_y_m += 0.03;
+  s.lateral_z_m -= 0.02;
+  s.port_range_m += 0.05;
+  s.tilt_y_deg += 0.5;
+  s.tilt_z_deg -= 0.4;
+  s.roll_deg += 8.0;
+  return testing::T_lidar_target(s);
+}
+
+// The methods configured for the sensor: the ideal one (noise off) has no detector walk to correct and no
+// range noise to allow for.
+std::unique_ptr<PoseMethod> makeMethod(EstimateMethod method, bool noise) {
+  AdapterFitOptions fit;
+  fit.saturated_range_bias_m = noise ? -0.02 : 0.0;
+  fit.range_sigma_m = noise ? 0.012 : 0.003;
+  if (method == EstimateMethod::kPyramid) {
+    PyramidOptions options;
+    options.fit = fit;
+    return std::make_unique<PyramidMethod>(issAdapterGeometry(), options);
+  }
+  RingDetectorOptions options;
+  options.fit = fit;
+  options.connect_step_m = noise ? 0.04 : 0.01;
+  return std::make_unique<RingMethod>(issAdapterGeometry(), options);
+}
+
+const char* name(EstimateMethod method) {
+  return method == EstimateMethod::kPyramid ? "pyramid" : "ring";
+}
+
+struct Sweep {
+  double lateral_max_m = 0.0, range_max_m = 0.0, tilt_sq = 0.0, roll_max_deg = 0.0;
+  int tilt_count = 0, frames = 0, lost = 0, roll_observed = 0;
+};
+
+// Port ranges from 7 m to contact, tilts within +-4 deg, lateral offsets and rolls.
+std::vector<ApproachState> closeRangeStates() {
+  std::vector<ApproachState> states;
+  const double ranges[] = {7.0, 6.0, 5.0, 4.0, 3.0, 2.5, 2.0, 1.5, 1.0, 0.6, 0.3, 0.0};
+  int k = 0;
+  for (double range : ranges) {
+    for (int variant = 0; variant < 3; ++variant, ++k) {
+      ApproachState s;
+      s.port_range_m = range;
+      // Tilt up to 4 deg in any direction, lateral offset up to 0.08 m (inside the capture envelope at
+      // contact: 4 deg, 0.10 m), roll up to 25 deg.
+      const double tilt_deg = 4.0 * std::abs(std::sin(1.3 * k)), tilt_direction = 2.4 * k;
+      s.tilt_y_deg = tilt_deg * std::cos(tilt_direction);
+      s.tilt_z_deg = tilt_deg * std::sin(tilt_direction);
+      const double lateral_m = 0.08 * std::abs(std::cos(0.9 * k)), lateral_direction = 1.7 * k;
+      s.lateral_y_m = lateral_m * std::cos(lateral_direction);
+      s.lateral_z_m = lateral_m * std::sin(lateral_direction);
+      s.roll_deg = 25.0 * std::sin(2.1 * k);
+      states.push_back(s);
+    }
+  }
+  return states;
+}
+
+Sweep runSweep(EstimateMethod method, bool noise) {
+  IssRenderer renderer(noise);
+  std::unique_ptr<PoseMethod> estimator = makeMethod(method, noise);
+  Sweep sweep;
+  int index = 0;
+  for (const ApproachState& s : closeRangeStates()) {
+    const Eigen::Isometry3d truth = testing::T_lidar_target(s);
+    const OrganizedCloud cloud = renderer.render(truth, index++);
+    const PoseResult result = estimator->estimate(cloud, predictionFrom(s));
+    ++sweep.frames;
+    if (result.status == EstimateStatus::kLost) {
+      ++sweep.lost;
+      std::printf("%s noise=%d range %.1f: LOST %s\n", name(method), noise, s.port_range_m,
+                  result.reason.c_str());
+      continue;
+    }
+    const PortError e = testing::portError(result.T_lidar_target, truth);
+    std::printf("%s noise=%d range %.1f: lateral %+.4f %+.4f range %+.4f tilt %+.3f %+.3f roll %+.2f (%s)\n",
+                name(method), noise, s.port_range_m, e.lateral_x_m, e.lateral_y_m, e.range_m,
+                e.rotation_deg.y(), e.rotation_deg.z(), e.rotation_deg.x(),
+                result.boresight_rotation_observed ? "observed" : "held");
+    sweep.lateral_max_m =
+        std::max(sweep.lateral_max_m, std::max(std::abs(e.lateral_x_m), std::abs(e.lateral_y_m)));
+    sweep.range_max_m = std::max(sweep.range_max_m, std::abs(e.range_m));
+    sweep.tilt_sq += e.rotation_deg.y() * e.rotation_deg.y() + e.rotation_deg.z() * e.rotation_deg.z();
+    sweep.tilt_count += 2;
+    if (result.boresight_rotation_observed) {
+      ++sweep.roll_observed;
+      sweep.roll_max_deg = std::max(sweep.roll_max_deg, std::abs(e.rotation_deg.x()));
+    }
+  }
+  const double tilt_rms = std::sqrt(sweep.tilt_sq / std::max(1, sweep.tilt_count));
+  std::printf(
+      "%s noise=%d: frames %d lost %d lateral_max %.4f m range_max %.4f m tilt_rms %.4f deg roll_max %.3f "
+      "deg "
+      "(observed on %d)\n",
+      name(method), noise, sweep.frames, sweep.lost, sweep.lateral_max_m, sweep.range_max_m, tilt_rms,
+      sweep.roll_max_deg, sweep.roll_observed);
+  sweep.tilt_sq = tilt_rms;
+  return sweep;
+}
+
+class CloseRangeGoals : public ::testing::TestWithParam<std::tuple<EstimateMethod, bool>> {};
+
+TEST_P(CloseRangeGoals, FromSevenMetresToContact) {
+  const EstimateMethod method = std::get<0>(GetParam());
+  const bool noise = std::get<1>(GetParam());
+  const Sweep sweep = runSweep(method, noise);
+  EXPECT_EQ(sweep.lost, 0);
+  EXPECT_LE(sweep.lateral_max_m, 0.02);
+  EXPECT_LE(sweep.range_max_m, 0.01);
+  EXPECT_LE(sweep.tilt_sq, noise ? 0.2 : 0.05);  // tilt RMS, deg
+  EXPECT_LE(sweep.roll_max_deg, 1.0);
+  EXPECT_GE(sweep.roll_observed, sweep.frames / 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, CloseRangeGoals,
+                         ::testing::Combine(::testing::Values(EstimateMethod::kRing,
+                                                              EstimateMethod::kPyramid),
+                                            ::testing::Bool()));
+
+}  // namespace
+}  // namespace close_range
+}  // namespace ardsim_pose
+
+namespace ardsim_pose {
+namespace close_range {
+namespace {
+
+// Either LOST, or (if a method still finds the adapter) an estimate within the goals: never a wrong pose.
+void expectLostOrRight(PoseMethod& method, const OrganizedCloud& cloud, const Eigen::Isometry3d& prediction,
+                       const Eigen::Isometry3d& truth, bool expect_lost) {
+  const PoseResult result = method.estimate(cloud, prediction);
+  if (expect_lost) EXPECT_EQ(result.status, EstimateStatus::kLost) << result.reason;
+  if (result.status == EstimateStatus::kLost) return;
+  const testing::PortError e = testing::portError(result.T_lidar_target, truth);
+  EXPECT_LT(e.lateral(), 0.02);
+  EXPECT_LT(std::abs(e.range_m), 0.01);
+}
+
+TEST(CloseRangeLost, RingOutOfViewOccludedOrEmpty) {
+  IssRenderer renderer(true);
+  RingMethod ring;
+  PyramidMethod pyramid;
+  for (double range : {4.0, 2.0, 0.5}) {
+    ApproachState s;
+    s.port_range_m = range;
+    const Eigen::Isometry3d truth = testing::T_lidar_target(s);
+    // The chaser turned 25 deg away: the adapter leaves the 20 deg field of view (the modules behind remain).
+    ApproachState away = s;
+    away.tilt_z_deg = 25.0;
+    const Eigen::Isometry3d truth_away = testing::T_lidar_target(away);
+    const OrganizedCloud cloud_away = renderer.render(truth_away, 1);
+    for (PoseMethod* method : {static_cast<PoseMethod*>(&ring), static_cast<PoseMethod*>(&pyramid)}) {
+      SCOPED_TRACE("range " + std::to_string(range));
+      // Predicted where it is (a tracker following the turn): the adapter is out of view.
+      expectLostOrRight(*method, cloud_away, truth_away, truth_away, true);
+      // Occluded: all but a strip along the top of the image blanked (no ring edge, no cross).
+      OrganizedCloud occluded = renderer.render(truth, 2);
+      for (std::size_t i = 30 * occluded.width; i < occluded.points.size(); ++i) {
+        occluded.points[i] = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+      }
+      expectLostOrRight(*method, occluded, truth, truth, true);
+      OrganizedCloud empty = occluded;
+      for (auto& p : empty.points) p = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+      expectLostOrRight(*method, empty, truth, truth, true);
+      OrganizedCloud malformed;
+      malformed.width = 256;
+      malformed.height = 256;  // no points at all
+      EXPECT_EQ(method->estimate(malformed, truth).status, EstimateStatus::kLost);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace close_range
+}  // namespace ardsim_pose

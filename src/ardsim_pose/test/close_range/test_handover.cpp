@@ -1,0 +1,76 @@
+// The hand-over from ICP to the close-range method in the estimator facade (method "auto"): an approach along
+// the docking axis, tilted and offset a little, through the switch at 7 m port to port, on rendered noisy
+// frames.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "ardsim_pose/estimator_factory.h"
+#include "rendering.h"
+
+namespace ardsim_pose {
+namespace close_range {
+namespace {
+
+double rms(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double v : values) sum += v * v;
+  return std::sqrt(sum / values.size());
+}
+
+TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
+  testing::IssRenderer renderer(true, 11);
+  PoseConfig config;
+  config.method = "auto";
+  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
+  std::vector<double> position_error, attitude_error;
+  std::vector<EstimateMethod> methods;
+  const int frames = 36;  // port range 9.0 m to 5.5 m, 0.1 m per 0.1 s frame
+  for (int k = 0; k < frames; ++k) {
+    testing::ApproachState s;
+    s.port_range_m = 9.0 - 0.1 * k;
+    s.tilt_y_deg = 1.5 - 0.03 * k;
+    s.tilt_z_deg = -1.0 + 0.02 * k;
+    s.lateral_y_m = 0.05 - 0.001 * k;
+    s.lateral_z_m = -0.03;
+    s.roll_deg = 5.0;
+    const Eigen::Isometry3d truth = testing::T_lidar_target(s);
+    if (k == 0) estimator->setPrior(truth);
+    OrganizedCloud cloud = renderer.render(truth, k);
+    cloud.stamp_s = 0.1 * k;
+    const EstimatorOutput out = estimator->process(cloud);
+    ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
+    methods.push_back(out.result.method);
+    const testing::PortError e = testing::portError(out.result.T_lidar_target, truth);
+    position_error.push_back(std::sqrt(e.lateral() * e.lateral() + e.range_m * e.range_m));
+    attitude_error.push_back(e.rotation_deg.norm());
+  }
+  // One switch, from ICP to the ring method.
+  int switch_frame = -1, switches = 0;
+  for (int k = 1; k < frames; ++k) {
+    if (methods[k] != methods[k - 1]) {
+      ++switches;
+      switch_frame = k;
+    }
+  }
+  ASSERT_EQ(switches, 1);
+  EXPECT_EQ(methods.front(), EstimateMethod::kIcp);
+  EXPECT_EQ(methods.back(), EstimateMethod::kRing);
+  // Around the switch (+-10 frames), the worst frame within 3 x the RMS of the window.
+  const int begin = std::max(0, switch_frame - 10), end = std::min(frames, switch_frame + 11);
+  const std::vector<double> p(position_error.begin() + begin, position_error.begin() + end);
+  const std::vector<double> a(attitude_error.begin() + begin, attitude_error.begin() + end);
+  EXPECT_LE(*std::max_element(p.begin(), p.end()), 3.0 * rms(p));
+  EXPECT_LE(*std::max_element(a.begin(), a.end()), 3.0 * rms(a));
+  std::printf(
+      "hand-over at frame %d: position worst %.4f m rms %.4f m, attitude worst %.3f deg rms %.3f deg\n",
+      switch_frame, *std::max_element(p.begin(), p.end()), rms(p), *std::max_element(a.begin(), a.end()),
+      rms(a));
+}
+
+}  // namespace
+}  // namespace close_range
+}  // namespace ardsim_pose
