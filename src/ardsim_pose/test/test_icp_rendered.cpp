@@ -10,6 +10,7 @@
 
 #include "ardsim_description/models.h"
 #include "ardsim_lidar/lidar_simulator.h"
+#include "ardsim_pose/dataset.h"
 #include "ardsim_pose/estimator_factory.h"
 #include "ardsim_pose/evaluation.h"
 
@@ -17,19 +18,6 @@ namespace ardsim_pose {
 namespace {
 
 using ardsim_description::TargetKind;
-
-OrganizedCloud toCloud(const ardsim_lidar::LidarFrame& frame, const ardsim_lidar::PixelRays& rays,
-                       double stamp_s) {
-  OrganizedCloud cloud;
-  cloud.width = frame.width;
-  cloud.height = frame.height;
-  cloud.stamp_s = stamp_s;
-  for (int i = 0; i < frame.width * frame.height; ++i) {
-    cloud.points.push_back(frame.range_m[i] * rays.ray(i));
-    cloud.intensity.push_back(frame.intensity[i]);
-  }
-  return cloud;
-}
 
 class RenderedIcp : public ::testing::Test {
  protected:
@@ -54,7 +42,7 @@ class RenderedIcp : public ::testing::Test {
     for (int k = 0; k < frames; ++k) {
       const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kIss, d_m - 0.01 * k);
       simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
-      const EstimatorOutput out = estimator->process(toCloud(frame, simulator.rays(), 0.1 * k));
+      const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
       statuses->push_back(out.result.status);
       if (last_reason) *last_reason = out.result.reason;
       error =
@@ -175,7 +163,7 @@ TEST_F(LostFrames, AnotherObjectIsLost) {
     simulator.simulate(dockingAxisPose(TargetKind::kHubble, d), 0, &frame);
     std::unique_ptr<PoseEstimator> estimator = makeEstimator(PoseConfig{}, iss_model_);
     estimator->setPrior(dockingAxisPose(TargetKind::kIss, d));
-    const EstimatorOutput out = estimator->process(toCloud(frame, simulator.rays(), 0.0));
+    const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.0));
     EXPECT_EQ(out.result.status, EstimateStatus::kLost) << d << " m: " << out.result.reason;
   }
 }
