@@ -88,6 +88,12 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/confirm_rotation_rad", &i.confirm_rotation_rad);
   read(nh, "icp/max_correction_m", &i.max_correction_m);
   read(nh, "icp/max_correction_rad", &i.max_correction_rad);
+  read(nh, "icp/search_iterations", &i.search_iterations);
+  read(nh, "icp/search_offset_m", &i.search_offset_m);
+  read(nh, "icp/search_rotation_rad", &i.search_rotation_rad);
+  read(nh, "icp/search_lateral_m", &i.search_lateral_m);
+  read(nh, "icp/search_lateral_step_m", &i.search_lateral_step_m);
+  read(nh, "icp/explained_distance_m", &i.explained_distance_m);
   read(nh, "estimator/median_filter", &c.estimator.median_filter);
   read(nh, "estimator/median_window", &c.estimator.median_window);
   read(nh, "estimator/velocity_smoothing", &c.estimator.velocity_smoothing);

@@ -57,4 +57,20 @@ OrganizedCloud loadFrame(const std::string& pcd_path, double stamp_s) {
   return out;
 }
 
+OrganizedCloud fromLidarFrame(const ardsim_lidar::LidarFrame& frame, const ardsim_lidar::PixelRays& rays,
+                              double stamp_s) {
+  OrganizedCloud cloud;
+  cloud.width = frame.width;
+  cloud.height = frame.height;
+  cloud.stamp_s = stamp_s;
+  const int size = frame.width * frame.height;
+  cloud.points.reserve(size);
+  cloud.intensity.reserve(size);
+  for (int i = 0; i < size; ++i) {
+    cloud.points.push_back(frame.range_m[i] * rays.ray(i));
+    cloud.intensity.push_back(frame.intensity[i]);
+  }
+  return cloud;
+}
+
 }  // namespace ardsim_pose

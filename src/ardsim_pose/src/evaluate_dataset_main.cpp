@@ -112,8 +112,14 @@ int run(int argc, char** argv) {
   const Arguments args = parseArguments(argc, argv);
   const std::vector<ardsim_pose::TruthRow> truth = ardsim_pose::readTruth(args.dataset + "/truth.csv");
   if (truth.empty()) throw std::runtime_error(args.dataset + "/truth.csv has no frames");
-  std::unique_ptr<ardsim_pose::PoseEstimator> estimator = ardsim_pose::makeEstimator(args.config);
-  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(args.config.target);
+  // The sensor's size is the dataset's (render_dataset --width/--height), the field of view the default.
+  ardsim_pose::PoseConfig config = args.config;
+  const ardsim_pose::OrganizedCloud first_cloud =
+      ardsim_pose::loadFrame(ardsim_pose::framePath(args.dataset, truth.front().frame), 0.0);
+  config.sensor.width = first_cloud.width;
+  config.sensor.height = first_cloud.height;
+  std::unique_ptr<ardsim_pose::PoseEstimator> estimator = ardsim_pose::makeEstimator(config);
+  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(config.target);
   const Eigen::Isometry3d& first = truth.front().T_lidar_target;
   estimator->setPrior(args.init == "truth" ? first
                                            : ardsim_pose::perturbPrior(first, T_target_port, {}, args.seed));

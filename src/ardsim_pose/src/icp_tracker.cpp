@@ -13,6 +13,10 @@ namespace ardsim_pose {
 
 namespace {
 
+// The acquisition search aligns and scores every kSearchStride-th scan point (speed); the final alignment
+// all.
+constexpr int kSearchStride = 3;
+
 void require(bool ok, const std::string& name, double value, const std::string& allowed) {
   if (!ok) throw std::invalid_argument(name + " = " + std::to_string(value) + " is out of range: " + allowed);
 }
@@ -81,6 +85,18 @@ void validate(const IcpOptions& o) {
   require(positive(o.confirm_rotation_rad), "icp/confirm_rotation_rad", o.confirm_rotation_rad, "> 0");
   require(positive(o.max_correction_m), "icp/max_correction_m", o.max_correction_m, "> 0");
   require(positive(o.max_correction_rad), "icp/max_correction_rad", o.max_correction_rad, "> 0");
+  require(o.search_iterations >= 1 && o.search_iterations <= o.max_iterations_acquisition,
+          "icp/search_iterations", o.search_iterations, "1 .. max_iterations_acquisition");
+  require(std::isfinite(o.search_offset_m) && o.search_offset_m >= 0.0 && o.search_offset_m <= 20.0,
+          "icp/search_offset_m", o.search_offset_m, "0 .. 20");
+  require(std::isfinite(o.search_lateral_m) && o.search_lateral_m >= 0.0 && o.search_lateral_m <= 20.0,
+          "icp/search_lateral_m", o.search_lateral_m, "0 .. 20");
+  require(positive(o.search_lateral_step_m) && o.search_lateral_step_m >= o.search_lateral_m / 20.0,
+          "icp/search_lateral_step_m", o.search_lateral_step_m, "> 0, >= search_lateral_m / 20");
+  require(
+      std::isfinite(o.search_rotation_rad) && o.search_rotation_rad >= 0.0 && o.search_rotation_rad <= 1.0,
+      "icp/search_rotation_rad", o.search_rotation_rad, "0 .. 1");
+  require(positive(o.explained_distance_m), "icp/explained_distance_m", o.explained_distance_m, "> 0");
 }
 
 IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model,
@@ -132,6 +148,206 @@ void IcpTracker::alignRange(Eigen::Isometry3d* T) {
   }
 }
 
+IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double gate, int max_iterations,
+                                        bool prune_unmatched, int stride) {
+  Alignment a;
+  a.T = T_start;
+  active_.clear();
+  for (std::size_t k = 0; k < scan_.size(); k += stride) active_.push_back(scan_[k]);
+  Eigen::Isometry3d& T = a.T;
+  Eigen::Isometry3d T_visibility = T;
+  visibility_.predict(*model_, T, &visible_);
+  for (; a.iterations < max_iterations && !a.converged; ++a.iterations) {
+    const Eigen::Isometry3d moved = T_visibility.inverse() * T;
+    if (moved.translation().norm() > options_.revisibility_translation_m ||
+        Eigen::AngleAxisd(moved.linear()).angle() > options_.revisibility_rotation_rad) {
+      visibility_.predict(*model_, T, &visible_);
+      T_visibility = T;
+    }
+    const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
+    const Eigen::Matrix3d R = T.linear();
+    correspondences_.clear();
+    const float gate_sq = static_cast<float>(gate * gate);
+    std::size_t kept = 0;
+    for (const Eigen::Vector3f& s : active_) {
+      float distance_sq = 0.0f;
+      const int j = model_->nearestVisible(T_target_lidar * s, gate_sq, visible_, &distance_sq);
+      if (j < 0) continue;
+      // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
+      // solar arrays, background returns. Searching for it again each iteration is the costliest query.
+      if (prune_unmatched) active_[kept++] = s;
+      Correspondence c;
+      c.scan = s.cast<double>();
+      c.model = T * model_->points()[j].cast<double>();
+      c.normal = R * model_->normals()[j].cast<double>();
+      c.residual = c.normal.dot(c.scan - c.model);
+      c.distance = std::sqrt(static_cast<double>(distance_sq));
+      correspondences_.push_back(c);
+    }
+    if (prune_unmatched) active_.resize(kept);
+    if (static_cast<int>(correspondences_.size()) < options_.min_points) {
+      a.failure = "too few correspondences with the model: " + std::to_string(correspondences_.size()) +
+                  " < " + std::to_string(options_.min_points);
+      return a;
+    }
+
+    scratch_.clear();
+    for (const Correspondence& c : correspondences_) scratch_.push_back(std::abs(c.residual));
+    const double sigma = std::max(options_.min_sigma_m, 1.4826 * median(&scratch_));
+    const double limit = options_.tukey_c * sigma;
+    a.centre.setZero();
+    for (const Correspondence& c : correspondences_) a.centre += c.model;
+    a.centre /= static_cast<double>(correspondences_.size());
+
+    // Normal equations of the point-to-plane residual for a twist (v, w) about `centre` (conditioning):
+    // p' = p + w x (p - centre) + v.
+    a.H.setZero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    a.inliers = 0;
+    a.inlier_sq_sum = 0.0;
+    a.weight_sum = 0.0;
+    a.weighted_sq_sum = 0.0;
+    for (const Correspondence& c : correspondences_) {
+      const double u = c.residual / limit;
+      if (std::abs(u) >= 1.0) continue;
+      const double w = (1.0 - u * u) * (1.0 - u * u);
+      Eigen::Matrix<double, 6, 1> J;
+      J.head<3>() = c.normal;
+      J.tail<3>() = (c.model - a.centre).cross(c.normal);
+      a.H.noalias() += w * J * J.transpose();
+      g.noalias() += w * c.residual * J;
+      ++a.inliers;
+      a.inlier_sq_sum += c.residual * c.residual;
+      a.weight_sum += w;
+      a.weighted_sq_sum += w * c.residual * c.residual;
+    }
+    if (a.inliers < options_.min_points) {
+      a.failure =
+          "too few inliers: " + std::to_string(a.inliers) + " < " + std::to_string(options_.min_points);
+      return a;
+    }
+    const Eigen::Matrix<double, 6, 1> delta = a.H.ldlt().solve(g);
+    if (!delta.allFinite()) {
+      a.failure = "diverged: singular normal equations";
+      return a;
+    }
+    const Eigen::Vector3d v = delta.head<3>();
+    const Eigen::Vector3d w = delta.tail<3>();
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (w.norm() > 0.0) step.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    step.translation() = a.centre + v - step.linear() * a.centre;
+    T = step * T;
+    a.converged = v.norm() < options_.converged_translation_m && w.norm() < options_.converged_rotation_rad;
+
+    scratch_.clear();
+    for (const Correspondence& c : correspondences_) scratch_.push_back(c.distance);
+    gate = std::clamp(4.0 * median(&scratch_), options_.gate_min_m, gate);
+  }
+  // The visibility of the final pose, for the coverage check.
+  visibility_.predict(*model_, T, &visible_);
+  return a;
+}
+
+int IcpTracker::explainedPoints(const Eigen::Isometry3d& T, int stride) const {
+  const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
+  const float reach = static_cast<float>(options_.gate_min_m);
+  int explained = 0;
+  for (std::size_t k = 0; k < scan_.size(); k += stride) {
+    const Eigen::Vector3f q = T_target_lidar * scan_[k];
+    float distance_sq = 0.0f;
+    const int j = model_->nearestVisible(q, reach * reach, visible_, &distance_sq);
+    if (j >= 0 && std::abs(model_->normals()[j].dot(q - model_->points()[j])) < options_.explained_distance_m)
+      ++explained;
+  }
+  return explained;
+}
+
+IcpTracker::Alignment IcpTracker::bestOf(const std::vector<Eigen::Isometry3d>& hypotheses, double gate_m) {
+  Alignment best;
+  best.failure = "no hypothesis";
+  int best_explained = -1;
+  for (const Eigen::Isometry3d& hypothesis : hypotheses) {
+    Alignment a = align(hypothesis, gate_m, options_.search_iterations, false, kSearchStride);
+    if (!a.failure.empty()) {
+      if (best_explained < 0) best = a;
+      continue;
+    }
+    const int explained = explainedPoints(a.T, kSearchStride);
+    if (explained > best_explained) {
+      best_explained = explained;
+      best = a;
+    }
+  }
+  return best;
+}
+
+IcpTracker::Alignment IcpTracker::acquire(const Eigen::Isometry3d& T_prior) {
+  // 1. Range from the depths, then the prior, lateral offsets of it and turns about the scan's centroid, each
+  // aligned briefly with the wide gate; the one that explains most scan points wins.
+  Eigen::Isometry3d T0 = T_prior;
+  alignRange(&T0);
+  std::vector<Eigen::Isometry3d> hypotheses;
+  for (int i = -1; i <= 1; ++i) {
+    for (int j = -1; j <= 1; ++j) {
+      Eigen::Isometry3d T = T0;
+      T.translation() += options_.search_offset_m * Eigen::Vector3d(i, j, 0.0);
+      hypotheses.push_back(T);
+    }
+  }
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& s : scan_) centroid += s.cast<double>();
+  centroid /= static_cast<double>(scan_.size());
+  for (int axis = 0; axis < 3 && options_.search_rotation_rad > 0.0; ++axis) {
+    for (double sign : {-1.0, 1.0}) {
+      Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
+      turn.linear() = Eigen::AngleAxisd(sign * options_.search_rotation_rad, Eigen::Vector3d::Unit(axis))
+                          .toRotationMatrix();
+      turn.translation() = centroid - turn.linear() * centroid;
+      hypotheses.push_back(turn * T0);
+    }
+  }
+  const Alignment coarse = bestOf(hypotheses, options_.gate_acquisition_m);
+  if (!coarse.failure.empty()) return coarse;
+
+  // 2. The structure repeats itself (truss bays) and slides along itself where the field of view clips it:
+  // local minima lie a bay apart across the boresight. Score a dense lateral grid around the coarse pose
+  // (without ICP, with its visibility) and align the best few cells.
+  struct Cell {
+    int explained;
+    Eigen::Isometry3d T;
+  };
+  std::vector<Cell> cells;
+  const int steps = static_cast<int>(std::round(options_.search_lateral_m / options_.search_lateral_step_m));
+  for (int i = -steps; i <= steps; ++i) {
+    for (int j = -steps; j <= steps; ++j) {
+      Eigen::Isometry3d T = coarse.T;
+      T.translation() += options_.search_lateral_step_m * Eigen::Vector3d(i, j, 0.0);
+      cells.push_back({explainedPoints(T, kSearchStride), T});
+    }
+  }
+  const std::size_t keep = std::min<std::size_t>(cells.size(), 3);
+  std::partial_sort(cells.begin(), cells.begin() + keep, cells.end(),
+                    [](const Cell& a, const Cell& b) { return a.explained > b.explained; });
+  hypotheses = {coarse.T};
+  for (std::size_t k = 0; k < keep; ++k) hypotheses.push_back(cells[k].T);
+  const Alignment fine = bestOf(hypotheses, options_.gate_tracking_m);
+  if (!fine.failure.empty()) return fine;
+  return align(fine.T, options_.gate_tracking_m, options_.max_iterations_acquisition, false, 1);
+}
+
+bool IcpTracker::extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const {
+  if (acquired_.size() < 2) return false;
+  const auto& [t_a, T_a] = acquired_[0];
+  const auto& [t_b, T_b] = acquired_[1];
+  if (!(t_b > t_a && stamp_s > t_b)) return false;
+  const double scale = (stamp_s - t_b) / (t_b - t_a);
+  const Eigen::AngleAxisd turn(T_b.linear() * T_a.linear().transpose());
+  *T = T_b;
+  T->translation() += scale * (T_b.translation() - T_a.translation());
+  T->linear() = Eigen::AngleAxisd(scale * turn.angle(), turn.axis()).toRotationMatrix() * T_b.linear();
+  return true;
+}
+
 PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted) {
   PoseResult result;
   result.method = EstimateMethod::kIcp;
@@ -144,6 +360,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     result.reason = reason;
     result.covariance.setZero();
     acquiring_ = true;
+    acquired_.clear();
     return result;
   };
   if (cloud.points.empty()) return lost("empty frame: no points");
@@ -178,102 +395,19 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   scan_.reserve(count);
   for (std::size_t k = 0; k < count; ++k) scan_.push_back(cloud.points[valid_[k * valid_.size() / count]]);
 
-  active_ = scan_;
-  Eigen::Isometry3d T = T_predicted;
-  if (acquiring) alignRange(&T);
-  Eigen::Isometry3d T_visibility = T;
-  visibility_.predict(*model_, T, &visible_);
-  double gate = acquiring ? options_.gate_acquisition_m : options_.gate_tracking_m;
-  const int max_iterations =
-      acquiring ? options_.max_iterations_acquisition : options_.max_iterations_tracking;
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  double sigma = options_.min_sigma_m;
-  bool converged = false;
-  int iteration = 0;
-  int inliers = 0;
-  double inlier_sq_sum = 0.0;
-  double weight_sum = 0.0;
-  double weighted_sq_sum = 0.0;
-  for (; iteration < max_iterations && !converged; ++iteration) {
-    const Eigen::Isometry3d moved = T_visibility.inverse() * T;
-    if (moved.translation().norm() > options_.revisibility_translation_m ||
-        Eigen::AngleAxisd(moved.linear()).angle() > options_.revisibility_rotation_rad) {
-      visibility_.predict(*model_, T, &visible_);
-      T_visibility = T;
-    }
-    const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
-    const Eigen::Matrix3d R = T.linear();
-    correspondences_.clear();
-    const float gate_sq = static_cast<float>(gate * gate);
-    std::size_t kept = 0;
-    for (const Eigen::Vector3f& s : active_) {
-      float distance_sq = 0.0f;
-      const int j = model_->nearestVisible(T_target_lidar * s, gate_sq, visible_, &distance_sq);
-      if (j < 0) continue;
-      // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
-      // solar arrays, background returns. Searching for it again each iteration is the costliest query.
-      if (!acquiring) active_[kept++] = s;
-      Correspondence c;
-      c.scan = s.cast<double>();
-      c.model = T * model_->points()[j].cast<double>();
-      c.normal = R * model_->normals()[j].cast<double>();
-      c.residual = c.normal.dot(c.scan - c.model);
-      c.distance = std::sqrt(static_cast<double>(distance_sq));
-      correspondences_.push_back(c);
-    }
-    if (!acquiring) active_.resize(kept);
-    if (static_cast<int>(correspondences_.size()) < options_.min_points)
-      return lost("too few correspondences with the model: " + std::to_string(correspondences_.size()) +
-                  " < " + std::to_string(options_.min_points));
-
-    scratch_.clear();
-    for (const Correspondence& c : correspondences_) scratch_.push_back(std::abs(c.residual));
-    sigma = std::max(options_.min_sigma_m, 1.4826 * median(&scratch_));
-    const double limit = options_.tukey_c * sigma;
-    centre.setZero();
-    for (const Correspondence& c : correspondences_) centre += c.model;
-    centre /= static_cast<double>(correspondences_.size());
-
-    // Normal equations of the point-to-plane residual for a twist (v, w) about `centre` (conditioning):
-    // p' = p + w x (p - centre) + v.
-    H.setZero();
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    inliers = 0;
-    inlier_sq_sum = 0.0;
-    weight_sum = 0.0;
-    weighted_sq_sum = 0.0;
-    for (const Correspondence& c : correspondences_) {
-      const double u = c.residual / limit;
-      if (std::abs(u) >= 1.0) continue;
-      const double w = (1.0 - u * u) * (1.0 - u * u);
-      Eigen::Matrix<double, 6, 1> J;
-      J.head<3>() = c.normal;
-      J.tail<3>() = (c.model - centre).cross(c.normal);
-      H.noalias() += w * J * J.transpose();
-      g.noalias() += w * c.residual * J;
-      ++inliers;
-      inlier_sq_sum += c.residual * c.residual;
-      weight_sum += w;
-      weighted_sq_sum += w * c.residual * c.residual;
-    }
-    if (inliers < options_.min_points)
-      return lost("too few inliers: " + std::to_string(inliers) + " < " +
-                  std::to_string(options_.min_points));
-    const Eigen::Matrix<double, 6, 1> delta = H.ldlt().solve(g);
-    if (!delta.allFinite()) return lost("diverged: singular normal equations");
-    const Eigen::Vector3d v = delta.head<3>();
-    const Eigen::Vector3d w = delta.tail<3>();
-    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-    if (w.norm() > 0.0) step.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
-    step.translation() = centre + v - step.linear() * centre;
-    T = step * T;
-    converged = v.norm() < options_.converged_translation_m && w.norm() < options_.converged_rotation_rad;
-
-    scratch_.clear();
-    for (const Correspondence& c : correspondences_) scratch_.push_back(c.distance);
-    gate = std::clamp(4.0 * median(&scratch_), options_.gate_min_m, gate);
-  }
+  const Alignment a =
+      acquiring ? acquire(T_predicted)
+                : align(T_predicted, options_.gate_tracking_m, options_.max_iterations_tracking, true, 1);
+  if (!a.failure.empty()) return lost(a.failure);
+  const Eigen::Isometry3d& T = a.T;
+  const Eigen::Matrix<double, 6, 6>& H = a.H;
+  const Eigen::Vector3d& centre = a.centre;
+  const bool converged = a.converged;
+  const int iteration = a.iterations;
+  const int inliers = a.inliers;
+  const double inlier_sq_sum = a.inlier_sq_sum;
+  const double weight_sum = a.weight_sum;
+  const double weighted_sq_sum = a.weighted_sq_sum;
   result.iterations = iteration;
   result.points_used = static_cast<int>(scan_.size());
   result.T_lidar_target = T;
@@ -330,15 +464,32 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
   if (condition < options_.degraded_condition)
     degraded.push_back(format("poorly constrained (condition %.1e)", condition));
-  // Acquisition ends when a frame agrees with the one before (its prediction): a local minimum of a single
-  // frame is not reported as TRACKING.
-  if (degraded.empty() && acquiring &&
-      (correction_m > options_.confirm_translation_m || correction_rad > options_.confirm_rotation_rad))
-    degraded.push_back(format("acquiring: %.3f m / %.3f deg from the previous frame", correction_m,
-                              correction_rad * 180.0 / M_PI));
+  // Acquisition ends when a frame agrees with the one before (its prediction), or with the constant-velocity
+  // extrapolation of the two acquisition estimates before (the target moves during acquisition): a local
+  // minimum of a single frame is not reported as TRACKING.
+  if (degraded.empty() && acquiring) {
+    const bool agrees_with_previous =
+        correction_m <= options_.confirm_translation_m && correction_rad <= options_.confirm_rotation_rad;
+    Eigen::Isometry3d T_extrapolated;
+    bool agrees_with_motion = false;
+    if (!agrees_with_previous && extrapolateAcquired(cloud.stamp_s, &T_extrapolated)) {
+      const Eigen::Isometry3d difference = T_extrapolated.inverse() * T;
+      agrees_with_motion =
+          (T.translation() - T_extrapolated.translation()).norm() <= options_.confirm_translation_m &&
+          Eigen::AngleAxisd(difference.linear()).angle() <= options_.confirm_rotation_rad;
+    }
+    if (!agrees_with_previous && !agrees_with_motion)
+      degraded.push_back(format("acquiring: %.3f m / %.3f deg from the previous frame", correction_m,
+                                correction_rad * 180.0 / M_PI));
+  }
+  if (acquiring) {
+    acquired_.push_back({cloud.stamp_s, T});
+    if (acquired_.size() > 2) acquired_.erase(acquired_.begin());
+  }
   if (degraded.empty()) {
     result.status = EstimateStatus::kTracking;
     acquiring_ = false;
+    acquired_.clear();
   } else {
     result.status = EstimateStatus::kDegraded;
     for (const std::string& reason : degraded) result.reason += (result.reason.empty() ? "" : "; ") + reason;

@@ -1,6 +1,8 @@
 // ICP on frames rendered in-process by the lidar core: acquisition from the coarse prior at 100, 30 and 10 m
-// with and without noise, to the accuracy goals; solar arrays turned away from the model; LOST (not a
-// wrong pose) on an empty frame, a garbage frame and a frame of another object.
+// with and without noise, within a few frames, to the accuracy goals, never a wrong pose as TRACKING;
+// solar arrays turned away from the model; LOST (not a wrong pose) on an empty frame, a garbage frame and a
+// frame of another object.
+#include <algorithm>
 #include <memory>
 #include <random>
 
@@ -8,6 +10,7 @@
 
 #include "ardsim_description/models.h"
 #include "ardsim_lidar/lidar_simulator.h"
+#include "ardsim_pose/dataset.h"
 #include "ardsim_pose/estimator_factory.h"
 #include "ardsim_pose/evaluation.h"
 
@@ -15,19 +18,6 @@ namespace ardsim_pose {
 namespace {
 
 using ardsim_description::TargetKind;
-
-OrganizedCloud toCloud(const ardsim_lidar::LidarFrame& frame, const ardsim_lidar::PixelRays& rays,
-                       double stamp_s) {
-  OrganizedCloud cloud;
-  cloud.width = frame.width;
-  cloud.height = frame.height;
-  cloud.stamp_s = stamp_s;
-  for (int i = 0; i < frame.width * frame.height; ++i) {
-    cloud.points.push_back(frame.range_m[i] * rays.ray(i));
-    cloud.intensity.push_back(frame.intensity[i]);
-  }
-  return cloud;
-}
 
 class RenderedIcp : public ::testing::Test {
  protected:
@@ -37,10 +27,10 @@ class RenderedIcp : public ::testing::Test {
   static void TearDownTestSuite() { iss_model_.reset(); }
 
   // Renders `frames` frames closing at 0.1 m/s from port distance d_m and runs the estimator from the prior.
-  // Returns the errors of the last frame; *statuses collects every frame's status.
+  // Returns the errors of the last frame; *statuses (and *errors) collect every frame's.
   PoseErrorValue track(const ardsim_description::TriangleMesh& mesh, double d_m, bool noise, int frames,
                        const Eigen::Isometry3d& prior, std::vector<EstimateStatus>* statuses,
-                       std::string* last_reason = nullptr) {
+                       std::string* last_reason = nullptr, std::vector<PoseErrorValue>* errors = nullptr) {
     ardsim_lidar::NoiseOptions noise_options;
     noise_options.enabled = noise;
     ardsim_lidar::LidarSimulator simulator(ardsim_lidar::SensorOptions{}, noise_options, 7);
@@ -52,11 +42,12 @@ class RenderedIcp : public ::testing::Test {
     for (int k = 0; k < frames; ++k) {
       const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kIss, d_m - 0.01 * k);
       simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
-      const EstimatorOutput out = estimator->process(toCloud(frame, simulator.rays(), 0.1 * k));
+      const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
       statuses->push_back(out.result.status);
       if (last_reason) *last_reason = out.result.reason;
       error =
           poseError(out.result.T_lidar_target, truth, ardsim_description::T_target_port(TargetKind::kIss));
+      if (errors) errors->push_back(error);
     }
     return error;
   }
@@ -70,44 +61,46 @@ struct Case {
   bool noise;
   double position_goal_m;
   double attitude_goal_deg;
-  PriorPerturbation prior;  // the coarse prior, except at 10 m (see README: acquisition there is not met)
-  int frames;
 };
 
 const PriorPerturbation kCoarse{10.0, 0.1, 2.0};  // the coarse prior
-const PriorPerturbation kFine{2.0, 0.02, 0.2};    // a tracking-size error
+const int kFrames = 6;
+const int kFramesToTrack = 3;  // "within a few frames": TRACKING by the third frame
 
 class Acquisition : public RenderedIcp, public ::testing::WithParamInterface<Case> {};
 
+// Seed 1 at 100 m is the case that used to settle a truss bay off (1.7 m, a perfect local fit) and was
+// reported TRACKING.
 TEST_P(Acquisition, ConvergesFromTheCoarsePriorToTheGoals) {
   const Case c = GetParam();
   const Eigen::Isometry3d truth0 = dockingAxisPose(TargetKind::kIss, c.port_distance_m);
-  for (std::uint64_t seed : {1u, 2u}) {
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
     const Eigen::Isometry3d prior =
-        perturbPrior(truth0, ardsim_description::T_target_port(TargetKind::kIss), c.prior, seed);
+        perturbPrior(truth0, ardsim_description::T_target_port(TargetKind::kIss), kCoarse, seed);
     std::vector<EstimateStatus> statuses;
+    std::vector<PoseErrorValue> errors;
     std::string reason;
-    const PoseErrorValue e = track(ardsim_description::buildIss(), c.port_distance_m, c.noise, c.frames,
-                                   prior, &statuses, &reason);
+    track(ardsim_description::buildIss(), c.port_distance_m, c.noise, kFrames, prior, &statuses, &reason,
+          &errors);
     SCOPED_TRACE("seed " + std::to_string(seed));
     EXPECT_EQ(statuses.back(), EstimateStatus::kTracking) << reason;
-    EXPECT_LT(e.port_position_error_m.norm(), c.position_goal_m);
-    EXPECT_LT(e.attitude_error_angle_rad * 180.0 / M_PI, c.attitude_goal_deg);
+    const auto first_tracking = std::find(statuses.begin(), statuses.end(), EstimateStatus::kTracking);
+    EXPECT_LT(first_tracking - statuses.begin(), kFramesToTrack);
+    for (std::size_t k = 0; k < statuses.size(); ++k) {
+      SCOPED_TRACE("frame " + std::to_string(k));
+      EXPECT_NE(statuses[k], EstimateStatus::kLost);
+      // Never a wrong pose reported as TRACKING.
+      if (statuses[k] != EstimateStatus::kTracking) continue;
+      EXPECT_LT(errors[k].port_position_error_m.norm(), c.position_goal_m);
+      EXPECT_LT(errors[k].attitude_error_angle_rad * 180.0 / M_PI, c.attitude_goal_deg);
+    }
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(Ranges, Acquisition,
-                         ::testing::Values(Case{29.0, false, 0.02, 0.05, kCoarse, 8},
-                                           Case{29.0, true, 0.02, 0.05, kCoarse, 8},
-                                           Case{9.0, false, 0.02, 0.05, kFine, 8},
-                                           Case{9.0, true, 0.02, 0.05, kFine, 8}));
-
-// KNOWN FAILURE (README, "Not met"): at 100 m the coarse prior of seed 1 settles in a wrong local minimum
-// (1.3-1.7 m, 5-6 deg) on a nearly static sequence: DEGRADED without noise, TRACKING with noise (the quality
-// checks do not catch it). Run with --gtest_also_run_disabled_tests.
-INSTANTIATE_TEST_SUITE_P(DISABLED_KnownFailure, Acquisition,
-                         ::testing::Values(Case{99.0, false, 0.05, 0.1, kCoarse, 8},
-                                           Case{99.0, true, 0.05, 0.1, kCoarse, 8}));
+                         ::testing::Values(Case{99.0, false, 0.05, 0.1}, Case{99.0, true, 0.05, 0.1},
+                                           Case{29.0, false, 0.02, 0.05}, Case{29.0, true, 0.02, 0.05},
+                                           Case{9.0, false, 0.02, 0.05}, Case{9.0, true, 0.02, 0.05}));
 
 TEST_F(RenderedIcp, SolarArraysTurnedFromTheModelDoNotMatter) {
   ardsim_description::IssOptions turned;
@@ -170,7 +163,7 @@ TEST_F(LostFrames, AnotherObjectIsLost) {
     simulator.simulate(dockingAxisPose(TargetKind::kHubble, d), 0, &frame);
     std::unique_ptr<PoseEstimator> estimator = makeEstimator(PoseConfig{}, iss_model_);
     estimator->setPrior(dockingAxisPose(TargetKind::kIss, d));
-    const EstimatorOutput out = estimator->process(toCloud(frame, simulator.rays(), 0.0));
+    const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.0));
     EXPECT_EQ(out.result.status, EstimateStatus::kLost) << d << " m: " << out.result.reason;
   }
 }

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "ardsim_lidar/sensor.h"
@@ -41,6 +43,18 @@ struct IcpOptions {
   double confirm_rotation_rad = 0.0035;
   double max_correction_m = 1.5;  // when tracking: a larger jump from the prediction is a divergence
   double max_correction_rad = 0.1;
+  // Acquisition search: a single ICP from a coarse prior can settle where the structure repeats or slides
+  // along itself (the truss bays, clipped by the field of view at 100 m): a perfect local fit metres off. So
+  // the attitude is searched first (brief ICPs from the prior, a 3 x 3 grid of lateral offsets of it and
+  // turns about the scan's centroid), then a dense lateral grid around that pose is scored, and the best
+  // cells are aligned. The winner of each stage is the pose that explains most scan points (within
+  // explained_distance_m of the visible model surface).
+  int search_iterations = 8;           // per hypothesis
+  double search_offset_m = 1.5;        // step of the 3 x 3 grid of offsets across the boresight
+  double search_rotation_rad = 0.12;   // turns about lidar x, y and z, both ways (0: none)
+  double search_lateral_m = 2.4;       // half-width of the lateral grid across the boresight
+  double search_lateral_step_m = 0.3;  // its step (below the spacing of the repeating structure)
+  double explained_distance_m = 0.05;
 };
 
 // Throws std::invalid_argument naming the option, its value and the allowed range.
@@ -54,7 +68,10 @@ class IcpTracker : public PoseMethod {
   PoseResult estimate(const OrganizedCloud& cloud,
                       const Eigen::Isometry3d& T_lidar_target_predicted) override;
   // Back to acquisition: the next frame starts from its prediction with the wide gate and more iterations.
-  void reset() override { acquiring_ = true; }
+  void reset() override {
+    acquiring_ = true;
+    acquired_.clear();
+  }
 
   bool acquiring() const { return acquiring_; }
   // Of the last frame: fraction of the cells where the model is predicted that the scan confirms.
@@ -66,6 +83,29 @@ class IcpTracker : public PoseMethod {
   const IcpOptions& options() const { return options_; }
 
  private:
+  // ICP from T_start; the gate starts at gate_m. Fills correspondences_ and the visibility of the result.
+  struct Alignment {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    std::string failure;  // non-empty: no estimate (LOST reason)
+    bool converged = false;
+    int iterations = 0;
+    int inliers = 0;
+    double inlier_sq_sum = 0.0;
+    double weight_sum = 0.0;
+    double weighted_sq_sum = 0.0;
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  };
+  // Uses every stride-th scan point.
+  Alignment align(const Eigen::Isometry3d& T_start, double gate_m, int max_iterations, bool prune_unmatched,
+                  int stride);
+  Alignment acquire(const Eigen::Isometry3d& T_prior);
+  // Of the hypotheses, each aligned for search_iterations, the one that explains most scan points.
+  Alignment bestOf(const std::vector<Eigen::Isometry3d>& hypotheses, double gate_m);
+  // Every stride-th scan point within explained_distance_m of the model surface visible in visible_, at T.
+  int explainedPoints(const Eigen::Isometry3d& T, int stride) const;
+  // The pose at stamp_s extrapolated at constant velocity from the last two acquisition estimates.
+  bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
   double coverage() const;
   void alignRange(Eigen::Isometry3d* T);
 
@@ -74,6 +114,8 @@ class IcpTracker : public PoseMethod {
   IcpOptions options_;
   VisibilityPredictor visibility_;
   bool acquiring_ = true;
+  std::vector<std::pair<double, Eigen::Isometry3d>>
+      acquired_;  // (stamp s, pose) of the last acquisition frames
   double coverage_ = 0.0;
   std::vector<std::uint8_t> visible_;
   std::vector<Eigen::Vector3f> scan_;
