@@ -2,7 +2,6 @@
 """Interface test of the truth_pose test tool: one METHOD_TRUTH estimate per stamp at which both truth odometries
 arrived, equal to the truth T_lidar_target (no noise configured), LOST inside a scripted interval, nothing for a
 stamp with only one odometry."""
-import math
 import sys
 import threading
 import time

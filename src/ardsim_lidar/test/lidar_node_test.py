@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """Interface test of the lidar node/nodelet: publishes /clock and the two truth odometries at a few stamps (as the
 dynamics node does in the lockstep) and checks that each step is answered with exactly one frame."""
-import math
 import subprocess
 import threading
 import time
