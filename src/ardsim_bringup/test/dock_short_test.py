@@ -38,8 +38,11 @@ class DockShort(unittest.TestCase):
         # One estimate per lidar frame, none LOST (truth_pose without dropouts), every frame in the summary.
         self.assertGreater(s["frames"], 500)
         self.assertEqual(s["lost_frames"], 0)
-        self.assertEqual(s["bag_frames"], s["frames"], "the recorder dropped estimates")
-        self.assertEqual(s["methods"]["truth"]["frames"], s["frames"])
+        # rosbag record has no back-pressure (it is outside the lockstep): on a loaded machine it may drop a few
+        # messages, which the summary reports (bag_frames, and per method the frames evaluated against recorded truth).
+        self.assertLessEqual(s["bag_frames"], s["frames"])
+        self.assertGreaterEqual(s["bag_frames"], 0.99 * s["frames"], "the recorder lost more than 1 % of the estimates")
+        self.assertGreaterEqual(s["methods"]["truth"]["frames"], 0.99 * s["frames"])
         self.assertLess(s["methods"]["truth"]["pos_max_m"], 1e-6)  # no noise: the stand-in reports truth
         self.assertGreater(s["delta_v_mps"], 0.0)
         self.assertGreater(s["real_time_factor"], 1.0)
@@ -50,7 +53,7 @@ class DockShort(unittest.TestCase):
         recorded = {t["topic"]: t["messages"] for t in info["topics"]}
         for topic in TOPICS:
             self.assertIn(topic, recorded)
-        self.assertGreaterEqual(recorded["/lidar/points"], s["frames"])
+        self.assertGreaterEqual(recorded["/lidar/points"], 0.99 * s["frames"])
         self.assertFalse(os.path.exists(os.path.join(out, "run.bag.active")))
         with rosbag.Bag(os.path.join(out, "run.bag")) as bag:
             for _, msg, _ in bag.read_messages(topics=["/lidar/points"]):

@@ -3,6 +3,7 @@
 respawn="true") and the run still ends in capture or a safe abort (10 s of retreat), never a collision."""
 import json
 import os
+import socket
 import subprocess
 import sys
 import threading
@@ -13,15 +14,17 @@ import rostest
 
 from scenario_run import ROOT, passed, scenario_variant
 
-PORT = 11893
 
 
 class PoseRespawn(unittest.TestCase):
     def test_killed_pose_node_is_respawned(self):
         out = os.path.join(ROOT, ".home", "scenario_tests", "pose_respawn")
         subprocess.run(["rm", "-rf", out], check=True)
-        env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % PORT)
-        launch = subprocess.Popen(["roslaunch", "-p", str(PORT), os.path.join(ROOT, "launch", "docking.launch"),
+        with socket.socket() as probe:  # a free port for a master of our own
+            probe.bind(("127.0.0.1", 0))
+            port = probe.getsockname()[1]
+        env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port)
+        launch = subprocess.Popen(["roslaunch", "-p", str(port), os.path.join(ROOT, "launch", "docking.launch"),
                                    "scenario:=" + scenario_variant("respawn", "dock_15m.yaml", abort_settle_s=10.0),
                                    "out:=" + out,
                                    "pose_source:=estimator", "record:=true", "use_nodelets:=false"],
@@ -40,7 +43,7 @@ class PoseRespawn(unittest.TestCase):
             if t >= 20:
                 subprocess.run(["rosnode", "kill", "/pose"], env=env, check=True)
                 killed = True
-        self.assertTrue(killed, "never reached 20 s of sim time")
+        self.assertTrue(killed, "never reached 20 s of sim time; roslaunch said:\n" + "".join(log)[-3000:])
         launch.wait(timeout=900)
         text = "".join(log)
         self.assertIn("[pose-", text)

@@ -136,9 +136,12 @@ LidarDriver::LidarDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
   empty_frame_.range_m.assign(pixels, std::numeric_limits<float>::quiet_NaN());
   empty_frame_.intensity = empty_frame_.range_m;
   fault_frame_ = empty_frame_;
-  points_publisher_ = nh.advertise<sensor_msgs::PointCloud2>("lidar/points", 2);
-  range_publisher_ = nh.advertise<sensor_msgs::Image>("lidar/range", 2);
-  camera_info_publisher_ = nh.advertise<sensor_msgs::CameraInfo>("lidar/camera_info", 2);
+  // Latched, like every lockstep output: a subscriber that connects late (the pose estimator still loading
+  // its model at start-up, or respawned) still gets the current step's frame, and the lockstep does not
+  // stall.
+  points_publisher_ = nh.advertise<sensor_msgs::PointCloud2>("lidar/points", 2, true);
+  range_publisher_ = nh.advertise<sensor_msgs::Image>("lidar/range", 2, true);
+  camera_info_publisher_ = nh.advertise<sensor_msgs::CameraInfo>("lidar/camera_info", 2, true);
   // The aggregator's conventional, global topic.
   diagnostics_publisher_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
   synchronizer_.registerCallback(&LidarDriver::onTruth, this);

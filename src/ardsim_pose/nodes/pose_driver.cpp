@@ -175,6 +175,10 @@ PoseDriver::PoseDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
 }
 
 void PoseDriver::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  if (last_estimate_ && msg->header.stamp == last_estimate_->header.stamp) {
+    estimate_publisher_.publish(last_estimate_);
+    return;
+  }
   std_msgs::Header header;
   header.stamp = msg->header.stamp;
   header.frame_id = options_.frame_id;
@@ -194,7 +198,8 @@ void PoseDriver::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   if (output.result.status == EstimateStatus::kLost)
     ARDSIM_WARN_THROTTLE(5.0, "pose: LOST at t = %.6f: %s", msg->header.stamp.toSec(),
                          output.result.reason.c_str());
-  estimate_publisher_.publish(toPoseEstimate(output, header));
+  last_estimate_ = toPoseEstimate(output, header);
+  estimate_publisher_.publish(last_estimate_);
   if (options_.publish_tf && output.result.status != EstimateStatus::kLost)
     tf_broadcaster_.sendTransform(toTransform(output.result.T_lidar_target, header, options_.child_frame_id));
 }

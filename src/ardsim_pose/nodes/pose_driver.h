@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include <ardsim_msgs/PoseEstimate.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -53,6 +54,10 @@ class PoseDriver {
   ros::Publisher estimate_publisher_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   OrganizedCloud cloud_;
+  // The last answer: a frame delivered twice (a latched publisher resends its last frame to a new connection)
+  // is answered again with it, not estimated twice, so the estimator's history does not depend on connection
+  // timing.
+  ardsim_msgs::PoseEstimateConstPtr last_estimate_;
 };
 
 }  // namespace ardsim_pose
