@@ -17,7 +17,8 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: evaluate_dataset --dataset DIR [--method icp|auto|ring|pyramid] [--init truth|perturbed] [--seed N]\n"
+    "usage: evaluate_dataset --dataset DIR [--method icp|auto|ring|pyramid] [--init truth|perturbed] [--seed "
+    "N]\n"
     "                        [--target iss|hubble] [--frame-period-s S] [--median-filter on|off]\n"
     "Runs the estimator over DIR/frame_*.pcd in the order of DIR/truth.csv; writes DIR/estimates.csv.\n"
     "--init truth: the first frame starts from its truth; perturbed (default): from the coarse prior\n"
