@@ -12,6 +12,10 @@ fi
 export ROS_HOME="${ROS_HOME:-$ARDSIM_ROOT/.ros}"
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://127.0.0.1:11311}" ROS_IP=127.0.0.1
 export ROSCONSOLE_STDOUT_LINE_BUFFERED=1
+# ccache: one cache for every checkout (CI builds a fresh clone), with paths made relative to the checkout so that
+# clones in other directories hit it. Set before XDG_CACHE_HOME moves, or ccache would keep a cache per checkout.
+export CCACHE_DIR="${CCACHE_DIR:-$HOME/.cache/ccache}"
+export CCACHE_BASEDIR="$ARDSIM_ROOT"
 # Mesa, Qt and rviz write caches under $HOME: keep them inside the workspace.
 export XDG_CACHE_HOME="${XDG_CACHE_HOME:-$ARDSIM_ROOT/.home/cache}"
 mkdir -p "$ROS_HOME" "$XDG_CACHE_HOME"
