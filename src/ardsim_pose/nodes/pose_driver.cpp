@@ -98,6 +98,18 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "estimator/median_window", &c.estimator.median_window);
   read(nh, "estimator/velocity_smoothing", &c.estimator.velocity_smoothing);
   read(nh, "estimator/max_prediction_gap_s", &c.estimator.max_prediction_gap_s);
+  close_range::ModeManagerOptions& m = c.mode;
+  read(nh, "mode/close_enter_range_m", &m.close_enter_range_m);
+  read(nh, "mode/close_enter_fill", &m.close_enter_fill);
+  read(nh, "mode/close_exit_range_m", &m.close_exit_range_m);
+  read(nh, "mode/lost_frames_to_exit", &m.lost_frames_to_exit);
+  read(nh, "mode/blend_frames", &m.blend_frames);
+  std::string close_method = m.close_method == EstimateMethod::kPyramid ? "pyramid" : "ring";
+  read(nh, "mode/close_method", &close_method);
+  if (close_method != "ring" && close_method != "pyramid")
+    throw std::invalid_argument("parameter mode/close_method = '" + close_method +
+                                "' is not allowed: ring or pyramid");
+  m.close_method = close_method == "pyramid" ? EstimateMethod::kPyramid : EstimateMethod::kRing;
   // The core names the option (e.g. "icp/max_points = 3 is out of range: ...").
   validated("", [&] { validate(c); });
 

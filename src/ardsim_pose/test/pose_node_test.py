@@ -116,10 +116,15 @@ class PoseInterfaceTest(unittest.TestCase):
         self.assertNotEqual(estimate.status, PoseEstimate.STATUS_LOST, estimate.reason)
 
     def test_bad_parameter_stops_the_node_with_a_clear_error(self):
-        result = subprocess.run(['rosrun', 'ardsim_pose', 'pose_node', '__name:=bad_pose', '_icp/max_points:=3'],
-                                capture_output=True, text=True, timeout=120)
-        self.assertNotEqual(result.returncode, 0)
-        self.assertIn('icp/max_points', result.stdout + result.stderr)
+        # One node name per case: a _param:= setting stays on the parameter server after its node exits.
+        cases = [('_icp/max_points:=3', 'icp/max_points = 3'),
+                 ('_mode/close_method:=laser', "mode/close_method = 'laser'"),
+                 ('_mode/close_exit_range_m:=5.0', 'mode/close_exit_range_m = 5')]
+        for case, (setting, named) in enumerate(cases):
+            result = subprocess.run(['rosrun', 'ardsim_pose', 'pose_node', '__name:=bad_pose_%d' % case, setting],
+                                    capture_output=True, text=True, timeout=120)
+            self.assertNotEqual(result.returncode, 0, setting)
+            self.assertIn(named, result.stdout + result.stderr, setting)
 
 
 if __name__ == '__main__':

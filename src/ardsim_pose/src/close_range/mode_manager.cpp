@@ -16,15 +16,15 @@ void require(bool ok, const std::string& name, double value, const std::string& 
 }  // namespace
 
 void validate(const ModeManagerOptions& o) {
-  require(o.close_enter_range_m > 0.0, "close_enter_range_m", o.close_enter_range_m, "> 0");
-  require(o.close_exit_range_m > o.close_enter_range_m, "close_exit_range_m", o.close_exit_range_m,
-          "> close_enter_range_m (hysteresis)");
-  require(o.close_enter_fill >= 0.0 && o.close_enter_fill <= 1.0, "close_enter_fill", o.close_enter_fill,
+  require(o.close_enter_range_m > 0.0, "mode/close_enter_range_m", o.close_enter_range_m, "> 0");
+  require(o.close_exit_range_m > o.close_enter_range_m, "mode/close_exit_range_m", o.close_exit_range_m,
+          "> mode/close_enter_range_m (hysteresis)");
+  require(o.close_enter_fill >= 0.0 && o.close_enter_fill <= 1.0, "mode/close_enter_fill", o.close_enter_fill,
           "0..1");
-  require(o.lost_frames_to_exit >= 1, "lost_frames_to_exit", o.lost_frames_to_exit, ">= 1");
-  require(o.blend_frames >= 1, "blend_frames", o.blend_frames, ">= 1");
+  require(o.lost_frames_to_exit >= 1, "mode/lost_frames_to_exit", o.lost_frames_to_exit, ">= 1");
+  require(o.blend_frames >= 1, "mode/blend_frames", o.blend_frames, ">= 1");
   require(o.close_method == EstimateMethod::kRing || o.close_method == EstimateMethod::kPyramid,
-          "close_method", static_cast<int>(o.close_method), "ring or pyramid");
+          "mode/close_method", static_cast<int>(o.close_method), "ring or pyramid");
 }
 
 double viewFill(const OrganizedCloud& cloud) {

@@ -1,6 +1,6 @@
 // The hand-over from ICP to the close-range method in the estimator facade (method "auto"): an approach along
-// the docking axis, tilted and offset a little, through the switch at 7 m port to port, on rendered noisy
-// frames.
+// the docking axis, tilted and offset a little, through the switch at 11 m port to port (12 m from the
+// lidar), on rendered noisy frames.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -28,10 +28,10 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
   std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
   std::vector<double> position_error, attitude_error;
   std::vector<EstimateMethod> methods;
-  const int frames = 36;  // port range 9.0 m to 5.5 m, 0.1 m per 0.1 s frame
+  const int frames = 36;  // port range 13.5 m to 10.0 m, 0.1 m per 0.1 s frame
   for (int k = 0; k < frames; ++k) {
     testing::ApproachState s;
-    s.port_range_m = 9.0 - 0.1 * k;
+    s.port_range_m = 13.5 - 0.1 * k;
     s.tilt_y_deg = 1.5 - 0.03 * k;
     s.tilt_z_deg = -1.0 + 0.02 * k;
     s.lateral_y_m = 0.05 - 0.001 * k;

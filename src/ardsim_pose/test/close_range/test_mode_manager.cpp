@@ -37,11 +37,12 @@ TEST(ModeManager, SwitchesOnceOnApproachAndBackWhenTheRangeOpens) {
 }
 
 TEST(ModeManager, DoesNotOscillateBetweenTheThresholds) {
-  ModeManager manager;
+  const ModeManagerOptions options;
+  ModeManager manager(options);
   std::vector<double> ranges;
   // Hovering around each threshold with +-0.5 m of noise: one switch in, none out.
-  for (int k = 0; k < 200; ++k) ranges.push_back(8.0 + ((k % 2) ? 0.5 : -0.5));
-  for (int k = 0; k < 200; ++k) ranges.push_back(10.0 - ((k % 2) ? 0.4 : 0.0));
+  for (int k = 0; k < 200; ++k) ranges.push_back(options.close_enter_range_m + ((k % 2) ? 0.5 : -0.5));
+  for (int k = 0; k < 200; ++k) ranges.push_back(options.close_exit_range_m - ((k % 2) ? 0.4 : 0.0));
   std::vector<EstimateMethod> methods;
   EXPECT_EQ(countSwitches(manager, ranges, &methods), 1);
 }
@@ -72,9 +73,9 @@ TEST(ModeManager, BlendsOverTheConfiguredFrames) {
 
 TEST(ModeManager, LeavesCloseRangeWhenLostBeyondTheEntryRange) {
   ModeManager manager(ModeManagerOptions{}, EstimateMethod::kRing);
-  EXPECT_EQ(manager.update(9.0, 1.0, true).method, EstimateMethod::kRing);
-  EXPECT_EQ(manager.update(9.0, 1.0, true).method, EstimateMethod::kRing);
-  EXPECT_EQ(manager.update(9.0, 1.0, true).method, EstimateMethod::kIcp);
+  EXPECT_EQ(manager.update(13.0, 1.0, true).method, EstimateMethod::kRing);
+  EXPECT_EQ(manager.update(13.0, 1.0, true).method, EstimateMethod::kRing);
+  EXPECT_EQ(manager.update(13.0, 1.0, true).method, EstimateMethod::kIcp);
   // Lost near the port: stay (ICP cannot do better there); the facade reports LOST.
   ModeManager near(ModeManagerOptions{}, EstimateMethod::kRing);
   for (int k = 0; k < 10; ++k) EXPECT_EQ(near.update(3.0, 1.0, true).method, EstimateMethod::kRing);
