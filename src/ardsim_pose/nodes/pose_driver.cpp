@@ -65,6 +65,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "visibility/depth_tolerance_m", &c.visibility.depth_tolerance_m);
   IcpOptions& i = c.icp;
   read(nh, "icp/max_points", &i.max_points);
+  read(nh, "icp/silhouette_margin_px", &i.silhouette_margin_px);
   read(nh, "icp/max_iterations_tracking", &i.max_iterations_tracking);
   read(nh, "icp/max_iterations_acquisition", &i.max_iterations_acquisition);
   read(nh, "icp/gate_tracking_m", &i.gate_tracking_m);

@@ -69,6 +69,9 @@ void validate(const IcpOptions& o) {
           o.revisibility_translation_m, "> 0");
   require(positive(o.revisibility_rotation_rad), "icp/revisibility_rotation_rad", o.revisibility_rotation_rad,
           "> 0");
+  require(std::isfinite(o.silhouette_margin_px) && o.silhouette_margin_px >= 0.0 &&
+              o.silhouette_margin_px <= 256.0,
+          "icp/silhouette_margin_px", o.silhouette_margin_px, "0 .. 256");
   require(o.min_points >= 6 && o.min_points <= o.max_points, "icp/min_points", o.min_points,
           "6 .. max_points");
   require(fraction(o.lost_inlier_fraction), "icp/lost_inlier_fraction", o.lost_inlier_fraction, "0 .. 1");
@@ -148,6 +151,60 @@ void IcpTracker::alignRange(Eigen::Isometry3d* T) {
   }
 }
 
+double IcpTracker::silhouetteInlierFraction(double limit_m) const {
+  const std::vector<float>& model_depth = visibility_.modelDepth();
+  const int w = visibility_.gridWidth(), h = visibility_.gridHeight(), cell = visibility_.cellPx();
+  auto on_silhouette = [&](const Eigen::Vector3d& p) {
+    if (!(p.z() > 0.0)) return false;
+    const double u = intrinsics_.fx * p.x() / p.z() + intrinsics_.cx + 0.5;
+    const double v = intrinsics_.fy * p.y() / p.z() + intrinsics_.cy + 0.5;
+    if (!(u >= 0.0 && v >= 0.0 && u < intrinsics_.width && v < intrinsics_.height)) return false;
+    const int x = static_cast<int>(u) / cell, y = static_cast<int>(v) / cell;
+    for (int j = std::max(0, y - 1); j <= std::min(h - 1, y + 1); ++j) {
+      for (int i = std::max(0, x - 1); i <= std::min(w - 1, x + 1); ++i) {
+        if (std::isfinite(model_depth[j * w + i])) return true;
+      }
+    }
+    return false;
+  };
+  int on = 0, inliers = 0;
+  for (const Eigen::Vector3f& s : scan_) on += on_silhouette(s.cast<double>()) ? 1 : 0;
+  for (const Correspondence& c : correspondences_) {
+    if (std::abs(c.residual) < limit_m && on_silhouette(c.scan)) ++inliers;
+  }
+  return on > 0 ? static_cast<double>(inliers) / on : 0.0;
+}
+
+void IcpTracker::gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isometry3d& T, double margin_px) {
+  gated_ = valid_;
+  if (!(margin_px > 0.0)) return;
+  visibility_.predict(*model_, T, &visible_);
+  const std::vector<float>& model_depth = visibility_.modelDepth();
+  const int w = visibility_.gridWidth(), h = visibility_.gridHeight();
+  const int r = static_cast<int>(std::ceil(margin_px / visibility_.cellPx()));
+  if (r >= std::max(w, h)) return;
+  // Square dilation of the silhouette's cells by r, separably (rows, then columns).
+  silhouette_rows_.assign(model_depth.size(), 0);
+  silhouette_.assign(model_depth.size(), 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (!std::isfinite(model_depth[y * w + x])) continue;
+      for (int k = std::max(0, x - r); k <= std::min(w - 1, x + r); ++k) silhouette_rows_[y * w + k] = 1;
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (!silhouette_rows_[y * w + x]) continue;
+      for (int k = std::max(0, y - r); k <= std::min(h - 1, y + r); ++k) silhouette_[k * w + x] = 1;
+    }
+  }
+  gated_.clear();
+  for (int i : valid_) {
+    if (silhouette_[visibility_.cellOfPixel(i % cloud.width, i / cloud.width)]) gated_.push_back(i);
+  }
+  if (static_cast<int>(gated_.size()) < options_.min_points) gated_ = valid_;
+}
+
 IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double gate, int max_iterations,
                                         bool prune_unmatched, int stride) {
   Alignment a;
@@ -195,6 +252,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     for (const Correspondence& c : correspondences_) scratch_.push_back(std::abs(c.residual));
     const double sigma = std::max(options_.min_sigma_m, 1.4826 * median(&scratch_));
     const double limit = options_.tukey_c * sigma;
+    a.limit_m = limit;
     a.centre.setZero();
     for (const Correspondence& c : correspondences_) a.centre += c.model;
     a.centre /= static_cast<double>(correspondences_.size());
@@ -390,10 +448,16 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   if (static_cast<int>(valid_.size()) < options_.min_points)
     return lost("too few points: " + std::to_string(valid_.size()) + " valid returns < " +
                 std::to_string(options_.min_points));
-  // Every k-th valid pixel (evenly spread, deterministic), at most max_points.
-  const std::size_t count = std::min<std::size_t>(valid_.size(), options_.max_points);
+  // Every k-th valid pixel near the predicted silhouette (evenly spread, deterministic), at most max_points.
+  double margin_px = options_.silhouette_margin_px;
+  if (acquiring && margin_px > 0.0) {
+    const double range_m = std::max(1.0, T_predicted.translation().norm());
+    margin_px += (options_.search_lateral_m + options_.search_offset_m) / range_m * intrinsics_.fx;
+  }
+  gateToSilhouette(cloud, T_predicted, margin_px);
+  const std::size_t count = std::min<std::size_t>(gated_.size(), options_.max_points);
   scan_.reserve(count);
-  for (std::size_t k = 0; k < count; ++k) scan_.push_back(cloud.points[valid_[k * valid_.size() / count]]);
+  for (std::size_t k = 0; k < count; ++k) scan_.push_back(cloud.points[gated_[k * gated_.size() / count]]);
 
   const Alignment a =
       acquiring ? acquire(T_predicted)
@@ -413,7 +477,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   result.T_lidar_target = T;
   result.T_lidar_target.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
   result.fit_rms_m = std::sqrt(inlier_sq_sum / std::max(1, inliers));
-  result.inlier_fraction = static_cast<double>(inliers) / static_cast<double>(scan_.size());
+  result.inlier_fraction = silhouetteInlierFraction(a.limit_m);
 
   // Covariance of (v, w) about the centre from the last normal equations, mapped to the target origin's
   // position and the rotation: delta_origin = v + w x (origin - centre).

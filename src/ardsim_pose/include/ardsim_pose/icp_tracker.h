@@ -16,7 +16,12 @@
 namespace ardsim_pose {
 
 struct IcpOptions {
-  int max_points = 1000;                // scan points per frame (evenly spread over the valid pixels)
+  int max_points = 1000;  // scan points per frame (evenly spread over the gated valid pixels)
+  // Scan points come only from pixels within this of the model's silhouette at the predicted pose (while
+  // acquiring, widened by the acquisition search's lateral reach); the rest are parts the rigid model leaves
+  // out (the solar arrays and radiators, which fill most of the view at 250 m) or other objects. 0: every
+  // valid pixel. When fewer than min_points pixels pass (a prediction far off), every valid pixel is used.
+  double silhouette_margin_px = 16.0;
   int max_iterations_tracking = 15;     // per frame once tracking
   int max_iterations_acquisition = 40;  // per frame while acquiring (from a prior or after LOST)
   double gate_tracking_m = 0.5;         // first correspondence gate when tracking
@@ -30,8 +35,8 @@ struct IcpOptions {
   double revisibility_rotation_rad = 0.02;
   // Quality: below the `lost_` limits the frame is LOST, below the `degraded_` ones DEGRADED.
   int min_points = 50;  // valid scan points, and correspondences
-  // Scan points within the Tukey limit of the model. Low at long range, where the solar arrays (not in the
-  // model) fill much of the view.
+  // Scan points within the Tukey limit of the model, of those on its silhouette at the estimated pose (the
+  // arrays and radiators around it are not in the rigid model).
   double lost_inlier_fraction = 0.15;
   double degraded_inlier_fraction = 0.3;
   double lost_fit_rms_m = 0.15;  // RMS plane residual of the inliers
@@ -93,6 +98,7 @@ class IcpTracker : public PoseMethod {
     double inlier_sq_sum = 0.0;
     double weight_sum = 0.0;
     double weighted_sq_sum = 0.0;
+    double limit_m = 0.0;  // the Tukey limit of the last iteration
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   };
@@ -108,6 +114,11 @@ class IcpTracker : public PoseMethod {
   bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
   double coverage() const;
   void alignRange(Eigen::Isometry3d* T);
+  // Of the scan points on the model's silhouette at the pose of the last visibility prediction (a cell with
+  // a predicted surface or next to one), the fraction within limit_m of the model in the last iteration.
+  double silhouetteInlierFraction(double limit_m) const;
+  // Keeps the valid_ pixels within margin_px of the model's silhouette at T (unless too few would remain).
+  void gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isometry3d& T, double margin_px);
 
   std::shared_ptr<const ReferenceModel> model_;
   ardsim_lidar::Intrinsics intrinsics_;
@@ -121,6 +132,9 @@ class IcpTracker : public PoseMethod {
   std::vector<Eigen::Vector3f> scan_;
   std::vector<Eigen::Vector3f> active_;  // scan points still searched for
   std::vector<int> valid_;
+  std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
+  std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
+  std::vector<std::uint8_t> silhouette_;       // cells within the margin of the silhouette
   std::vector<float> scan_depth_;
   struct Correspondence {
     Eigen::Vector3d scan;    // lidar frame
