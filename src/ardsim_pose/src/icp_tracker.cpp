@@ -151,6 +151,23 @@ void IcpTracker::alignRange(Eigen::Isometry3d* T) {
   }
 }
 
+bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H,
+                                   const Eigen::Vector3d& centre) const {
+  // Rotations scaled by the lever arm so that units compare; the information about the boresight rotation
+  // once the other five are free, against the largest eigenvalue.
+  double lever_sq = 0.0;
+  for (const Correspondence& c : correspondences_) lever_sq += (c.model - centre).squaredNorm();
+  const double lever = std::sqrt(lever_sq / std::max<std::size_t>(1, correspondences_.size()));
+  Eigen::Matrix<double, 6, 1> scale;
+  scale << 1, 1, 1, 1.0 / lever, 1.0 / lever, 1.0 / lever;
+  const Eigen::Matrix<double, 6, 6> H_scaled = scale.asDiagonal() * H * scale.asDiagonal();
+  const double largest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
+          .eigenvalues()(5);
+  const Eigen::Matrix<double, 6, 1> column = H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 1>::Unit(5));
+  return largest > 0.0 && column(5) > 0.0 && 1.0 / column(5) / largest > options_.degraded_condition;
+}
+
 double IcpTracker::silhouetteInlierFraction(double limit_m) const {
   const std::vector<float>& model_depth = visibility_.modelDepth();
   const int w = visibility_.gridWidth(), h = visibility_.gridHeight(), cell = visibility_.cellPx();
@@ -284,7 +301,14 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
           "too few inliers: " + std::to_string(a.inliers) + " < " + std::to_string(options_.min_points);
       return a;
     }
-    const Eigen::Matrix<double, 6, 1> delta = a.H.ldlt().solve(g);
+    // A rotation about the boresight that the scan does not constrain (the roll of a cylinder such as Hubble
+    // about its axis) is held at its prediction: left free it wanders on noise and never converges.
+    Eigen::Matrix<double, 6, 1> delta = Eigen::Matrix<double, 6, 1>::Zero();
+    if (boresightObserved(a.H, a.centre)) {
+      delta = a.H.ldlt().solve(g);
+    } else {
+      delta.head<5>() = a.H.topLeftCorner<5, 5>().ldlt().solve(g.head<5>());
+    }
     if (!delta.allFinite()) {
       a.failure = "diverged: singular normal equations";
       return a;
@@ -498,16 +522,27 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(H_scaled);
   const double largest = eigen.eigenvalues()(5);
   const double condition = largest > 0.0 ? eigen.eigenvalues()(0) / largest : 0.0;
-  // Information about the boresight rotation once the other five are free.
-  const Eigen::Matrix<double, 6, 6> scaled_inverse =
-      H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
-  result.boresight_rotation_observed =
-      largest > 0.0 && 1.0 / scaled_inverse(5, 5) / largest > options_.degraded_condition;
+  result.boresight_rotation_observed = boresightObserved(H, centre);
+  // With the boresight rotation unobserved (held at its prediction, flagged), the pose is still good when
+  // the other five are well constrained: judge the condition of those five.
+  double condition_of_the_rest = condition;
+  if (!result.boresight_rotation_observed && largest > 0.0) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> rest(H_scaled.topLeftCorner<5, 5>());
+    condition_of_the_rest = rest.eigenvalues()(0) / largest;
+  }
 
   coverage_ = coverage();
-  const Eigen::Isometry3d correction = T_predicted.inverse() * T;
   const double correction_m = (T.translation() - T_predicted.translation()).norm();
-  const double correction_rad = Eigen::AngleAxisd(correction.linear()).angle();
+  // Rotation between two poses, in lidar axes; the boresight part left out when it is not observed (a
+  // symmetric target's roll is arbitrary: acquisition frames may disagree about it and still be right).
+  const bool boresight_observed = result.boresight_rotation_observed;
+  auto turn_rad = [boresight_observed](const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
+    const Eigen::AngleAxisd turn(R_b * R_a.transpose());
+    Eigen::Vector3d r = turn.angle() * turn.axis();
+    if (!boresight_observed) r.z() = 0.0;
+    return r.norm();
+  };
+  const double correction_rad = turn_rad(T_predicted.linear(), T.linear());
   std::vector<std::string> degraded;
   if (!acquiring &&
       (correction_m > options_.max_correction_m || correction_rad > options_.max_correction_rad))
@@ -526,7 +561,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   if (result.fit_rms_m > options_.degraded_fit_rms_m)
     degraded.push_back(format("fit rms %.3f m", result.fit_rms_m));
   if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
-  if (condition < options_.degraded_condition)
+  if (condition_of_the_rest < options_.degraded_condition)
     degraded.push_back(format("poorly constrained (condition %.1e)", condition));
   // Acquisition ends when a frame agrees with the one before (its prediction), or with the constant-velocity
   // extrapolation of the two acquisition estimates before (the target moves during acquisition): a local
@@ -537,10 +572,9 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     Eigen::Isometry3d T_extrapolated;
     bool agrees_with_motion = false;
     if (!agrees_with_previous && extrapolateAcquired(cloud.stamp_s, &T_extrapolated)) {
-      const Eigen::Isometry3d difference = T_extrapolated.inverse() * T;
       agrees_with_motion =
           (T.translation() - T_extrapolated.translation()).norm() <= options_.confirm_translation_m &&
-          Eigen::AngleAxisd(difference.linear()).angle() <= options_.confirm_rotation_rad;
+          turn_rad(T_extrapolated.linear(), T.linear()) <= options_.confirm_rotation_rad;
     }
     if (!agrees_with_previous && !agrees_with_motion)
       degraded.push_back(format("acquiring: %.3f m / %.3f deg from the previous frame", correction_m,

@@ -114,6 +114,10 @@ class IcpTracker : public PoseMethod {
   bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
   double coverage() const;
   void alignRange(Eigen::Isometry3d* T);
+  // Whether the normal equations H (about centre, from correspondences_) constrain the rotation about the
+  // boresight: its information with the other five free, over the largest eigenvalue (lever-scaled), above
+  // degraded_condition.
+  bool boresightObserved(const Eigen::Matrix<double, 6, 6>& H, const Eigen::Vector3d& centre) const;
   // Of the scan points on the model's silhouette at the pose of the last visibility prediction (a cell with
   // a predicted surface or next to one), the fraction within limit_m of the model in the last iteration.
   double silhouetteInlierFraction(double limit_m) const;
