@@ -602,7 +602,7 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   const double petal_angle = std::arg(petal_sum) / 3.0;
   const double cross_angle = r.cross_angle;
   const double cross_pixel_m = (std::abs(r.d) - g.cross_face_x_m) * options_.pixel_pitch_rad;
-  const bool cross_fine = cross_pixel_m < 0.008;  // arms 5+ pixels wide (at 4 the angle is biased ~1 deg)
+  const bool cross_fine = cross_pixel_m < 0.006;  // arms 6.7+ pixels wide (at 4-5 the angle is biased ~1 deg)
   double boresight = prior_angle;
   if (r.report.petals && r.report.cross_angle) {
     // The one petal branch that agrees with a cross branch (wrong pairs differ by 30 deg or more).
