@@ -114,6 +114,8 @@ class IcpTracker : public PoseMethod {
   bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
   double coverage() const;
   void alignRange(Eigen::Isometry3d* T);
+  // visibility_.predict at T into visible_, unless the last prediction was at exactly T.
+  void predictVisibility(const Eigen::Isometry3d& T);
   // Whether the normal equations H (about centre, from correspondences_) constrain the rotation about the
   // boresight: its information with the other five free, over the largest eigenvalue (lever-scaled), above
   // degraded_condition.
@@ -133,6 +135,8 @@ class IcpTracker : public PoseMethod {
       acquired_;  // (stamp s, pose) of the last acquisition frames
   double coverage_ = 0.0;
   std::vector<std::uint8_t> visible_;
+  Eigen::Isometry3d visibility_pose_ = Eigen::Isometry3d::Identity();  // pose of the last prediction
+  bool visibility_valid_ = false;
   std::vector<Eigen::Vector3f> scan_;
   std::vector<Eigen::Vector3f> active_;  // scan points still searched for
   std::vector<int> valid_;
