@@ -15,6 +15,8 @@ namespace ardsim_lidar {
 
 namespace {
 
+constexpr std::uint32_t kRecorderQueue = 50;  // frames queued per subscriber connection
+
 // A parameter that is set but has the wrong type is an error, not a silent default.
 template <typename T>
 void read(const ros::NodeHandle& nh, const std::string& name, T* value) {
@@ -138,10 +140,11 @@ LidarDriver::LidarDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
   fault_frame_ = empty_frame_;
   // Latched, like every lockstep output: a subscriber that connects late (the pose estimator still loading
   // its model at start-up, or respawned) still gets the current step's frame, and the lockstep does not
-  // stall.
-  points_publisher_ = nh.advertise<sensor_msgs::PointCloud2>("lidar/points", 2, true);
-  range_publisher_ = nh.advertise<sensor_msgs::Image>("lidar/range", 2, true);
-  camera_info_publisher_ = nh.advertise<sensor_msgs::CameraInfo>("lidar/camera_info", 2, true);
+  // stall. Each subscriber's connection queues up to 50 frames (65 MB of clouds) so that a recorder stalled
+  // by its disk for a few seconds of wall time loses nothing (with 2 it lost 1-2 % of a run's messages).
+  points_publisher_ = nh.advertise<sensor_msgs::PointCloud2>("lidar/points", kRecorderQueue, true);
+  range_publisher_ = nh.advertise<sensor_msgs::Image>("lidar/range", kRecorderQueue, true);
+  camera_info_publisher_ = nh.advertise<sensor_msgs::CameraInfo>("lidar/camera_info", kRecorderQueue, true);
   // The aggregator's conventional, global topic.
   diagnostics_publisher_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
   synchronizer_.registerCallback(&LidarDriver::onTruth, this);

@@ -27,7 +27,7 @@ class PoseEvaluator {
       throw std::invalid_argument("parameter buffer_size = " + std::to_string(buffer_size_) +
                                   " is out of range: 1 .. 10000");
     T_chaser_lidar_ = ardsim_description::T_chaser_lidar();
-    error_publisher_ = nh.advertise<ardsim_msgs::PoseError>("pose/error", 10, true);
+    error_publisher_ = nh.advertise<ardsim_msgs::PoseError>("pose/error", 1000, true);  // see pose/estimate
     estimate_subscriber_ = nh.subscribe("pose/estimate", 10, &PoseEvaluator::onEstimate, this);
     target_subscriber_ = nh.subscribe("truth/target/odom", 10, &PoseEvaluator::onTarget, this);
     chaser_subscriber_ = nh.subscribe("truth/chaser/odom", 10, &PoseEvaluator::onChaser, this);

@@ -177,8 +177,9 @@ PoseDriver::PoseDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
     : options_(loadOptions(private_nh)), estimator_(makeEstimator(options_.config)) {
   const Eigen::Isometry3d initial = initialEstimate(options_);
   estimator_->setPrior(initial);
-  // Latched: a subscriber that connects late still gets the current step's estimate.
-  estimate_publisher_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 2, true);
+  // Latched: a subscriber that connects late still gets the current step's estimate. A deep queue per
+  // subscriber: a recorder stalled by its disk must not lose estimates (with 2 it lost runs of ~80).
+  estimate_publisher_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 1000, true);
   cloud_subscriber_ = nh.subscribe("lidar/points", 2, &PoseDriver::onCloud, this);
   ROS_INFO("pose: %s, method %s, %dx%d %.1f deg, initial %s (%.2f %.2f %.2f m)%s",
            ardsim_description::targetKindName(options_.config.target).c_str(), options_.config.method.c_str(),
