@@ -157,7 +157,8 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
     double x = 0.0;  // the face's x in the port frame
     double count = 0.0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    std::array<double, 6> upper{};  // the scatter's upper triangle, row by row (p p^T is symmetric)
+    Eigen::Matrix3d scatter;
   };
   Eigen::Vector3d n = *normal;
   double d = *offset;
@@ -178,9 +179,19 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
       f.x = pp.face_x;
       f.count += 1.0;
       f.sum += pp.p;
-      f.scatter.noalias() += pp.p * pp.p.transpose();
+      const Eigen::Vector3d& p = pp.p;
+      f.upper[0] += p.x() * p.x();
+      f.upper[1] += p.x() * p.y();
+      f.upper[2] += p.x() * p.z();
+      f.upper[3] += p.y() * p.y();
+      f.upper[4] += p.y() * p.z();
+      f.upper[5] += p.z() * p.z();
       sum_sq += residual * residual;
       ++inliers;
+    }
+    for (FaceSums& f : faces) {
+      const std::array<double, 6>& u = f.upper;
+      f.scatter << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
     }
     if (inliers * static_cast<int>(step) < options_.min_plane_points) return false;
     *rms = std::sqrt(sum_sq / inliers);
@@ -359,33 +370,44 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   inner_edge_.clear();
   outer_edge_.clear();
   const int width = frame.width, height = frame.height;
+  // n.p of every pixel, once: each is read again as a neighbour of four.
+  along_.resize(frame.points.size());
+  for (std::size_t i = 0; i < frame.points.size(); ++i) along_[i] = n.dot(frame.points[i].cast<double>());
+  const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  // Whether the neighbour in direction step can make pixel (u, v) an edge: behind the plane, or no return
+  // with a return beyond it to extrapolate from.
+  const auto edgeNeighbour = [&](int u, int v, const int* step) {
+    const int uj = u + step[0], vj = v + step[1], uk = u - step[0], vk = v - step[1];
+    if (uj < 0 || uj >= width || vj < 0 || vj >= height) return false;
+    const int j = vj * width + uj;
+    if (frame.isValid(j)) return d - along_[j] >= on_plane;
+    return uk >= 0 && uk < width && vk >= 0 && vk < height && frame.isValid(vk * width + uk);
+  };
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       const int i = v * width + u;
       if (!frame.isValid(i)) continue;
+      if (std::abs(along_[i] - d) > on_plane) continue;
+      // Most plane pixels are inside the ring's face: skip them before the projection.
+      if (!edgeNeighbour(u, v, steps[0]) && !edgeNeighbour(u, v, steps[1]) &&
+          !edgeNeighbour(u, v, steps[2]) && !edgeNeighbour(u, v, steps[3])) {
+        continue;
+      }
       const Eigen::Vector3d p = frame.points[i].cast<double>();
-      if (std::abs(n.dot(p) - d) > on_plane) continue;
-      const Eigen::Vector2d si = inPlane(p * (d / n.dot(p)));
+      const Eigen::Vector2d si = inPlane(p * (d / along_[i]));
       // On the docking plane and near the ring (the labels stop short of the edges, so go by geometry here).
       const double radius = (si - r.centre_guess).norm();
       if (radius < g.ring_inner_radius_m - edge_window || radius > g.ring_outer_radius_m + edge_window)
         continue;
-      const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
       for (const auto& step : steps) {
+        if (!edgeNeighbour(u, v, step)) continue;
         const int uj = u + step[0], vj = v + step[1], uk = u - step[0], vk = v - step[1];
-        if (uj < 0 || uj >= width || vj < 0 || vj >= height) continue;
         const int j = vj * width + uj;
         Eigen::Vector3d ray_j;
         if (frame.isValid(j)) {
-          const Eigen::Vector3d pj = frame.points[j].cast<double>();
-          const double behind = d - n.dot(pj);
-          if (behind < on_plane) continue;  // on the plane too, or in front (a petal)
-          ray_j = pj;
+          ray_j = frame.points[j].cast<double>();
         } else {
-          if (uk < 0 || uk >= width || vk < 0 || vk >= height) continue;
-          const int k = vk * width + uk;
-          if (!frame.isValid(k)) continue;
-          const Eigen::Vector3d pk = frame.points[k].cast<double>();
+          const Eigen::Vector3d pk = frame.points[vk * width + uk].cast<double>();
           ray_j = 2.0 * p / p.z() - pk / pk.z();
         }
         const double along = n.dot(ray_j);
