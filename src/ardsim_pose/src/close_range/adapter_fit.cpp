@@ -450,21 +450,41 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
       used = 0;
       int outer_used = 0;
       const auto add = [&](const std::vector<Eigen::Vector2d>& pts, int radius_index) {
+        // J = (jx, jy, -1 at radius_index, 0): only H's nonzero terms, in local scalars (H and grad captured
+        // by reference stay in memory and each step waits on the previous store), summed in the same order.
+        double h00 = H(0, 0), h01 = H(0, 1), h11 = H(1, 1), h0r = H(0, radius_index),
+               h1r = H(1, radius_index), hrr = H(radius_index, radius_index);
+        double g0 = grad(0), g1 = grad(1), gr = grad(radius_index);
+        const double x0 = x(0), x1 = x(1), radius_model = x(radius_index);
         for (const Eigen::Vector2d& s : pts) {
-          const Eigen::Vector2d offset = s - x.head<2>();
+          const Eigen::Vector2d offset = s - Eigen::Vector2d(x0, x1);
           const double radius = offset.norm();
           if (radius < 1e-6) continue;
-          const double residual = radius - x(radius_index);
+          const double residual = radius - radius_model;
           if (std::abs(residual) > reject) continue;
-          Eigen::Vector4d J = Eigen::Vector4d::Zero();
-          J.head<2>() = -offset / radius;
-          J(radius_index) = -1.0;
-          H += J * J.transpose();
-          grad += J * residual;
+          const double jx = -offset.x() / radius, jy = -offset.y() / radius;
+          h00 += jx * jx;
+          h01 += jx * jy;
+          h11 += jy * jy;
+          h0r -= jx;
+          h1r -= jy;
+          hrr += 1.0;
+          g0 += jx * residual;
+          g1 += jy * residual;
+          gr -= residual;
           sum_sq += residual * residual;
           ++used;
           outer_used += radius_index == 3 ? 1 : 0;
         }
+        H(0, 0) = h00;
+        H(0, 1) = H(1, 0) = h01;
+        H(1, 1) = h11;
+        H(0, radius_index) = H(radius_index, 0) = h0r;
+        H(1, radius_index) = H(radius_index, 1) = h1r;
+        H(radius_index, radius_index) = hrr;
+        grad(0) = g0;
+        grad(1) = g1;
+        grad(radius_index) = gr;
       };
       add(inner_edge_, 2);
       if (use_outer) add(outer_edge_, 3);
