@@ -157,7 +157,8 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
     double x = 0.0;  // the face's x in the port frame
     double count = 0.0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    std::array<double, 6> upper{};  // the scatter's upper triangle, row by row (p p^T is symmetric)
+    Eigen::Matrix3d scatter;
   };
   Eigen::Vector3d n = *normal;
   double d = *offset;
@@ -178,9 +179,19 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
       f.x = pp.face_x;
       f.count += 1.0;
       f.sum += pp.p;
-      f.scatter.noalias() += pp.p * pp.p.transpose();
+      const Eigen::Vector3d& p = pp.p;
+      f.upper[0] += p.x() * p.x();
+      f.upper[1] += p.x() * p.y();
+      f.upper[2] += p.x() * p.z();
+      f.upper[3] += p.y() * p.y();
+      f.upper[4] += p.y() * p.z();
+      f.upper[5] += p.z() * p.z();
       sum_sq += residual * residual;
       ++inliers;
+    }
+    for (FaceSums& f : faces) {
+      const std::array<double, 6>& u = f.upper;
+      f.scatter << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
     }
     if (inliers * static_cast<int>(step) < options_.min_plane_points) return false;
     *rms = std::sqrt(sum_sq / inliers);
@@ -359,33 +370,44 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   inner_edge_.clear();
   outer_edge_.clear();
   const int width = frame.width, height = frame.height;
+  // n.p of every pixel, once: each is read again as a neighbour of four.
+  along_.resize(frame.points.size());
+  for (std::size_t i = 0; i < frame.points.size(); ++i) along_[i] = n.dot(frame.points[i].cast<double>());
+  const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  // Whether the neighbour in direction step can make pixel (u, v) an edge: behind the plane, or no return
+  // with a return beyond it to extrapolate from.
+  const auto edgeNeighbour = [&](int u, int v, const int* step) {
+    const int uj = u + step[0], vj = v + step[1], uk = u - step[0], vk = v - step[1];
+    if (uj < 0 || uj >= width || vj < 0 || vj >= height) return false;
+    const int j = vj * width + uj;
+    if (frame.isValid(j)) return d - along_[j] >= on_plane;
+    return uk >= 0 && uk < width && vk >= 0 && vk < height && frame.isValid(vk * width + uk);
+  };
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       const int i = v * width + u;
       if (!frame.isValid(i)) continue;
+      if (std::abs(along_[i] - d) > on_plane) continue;
+      // Most plane pixels are inside the ring's face: skip them before the projection.
+      if (!edgeNeighbour(u, v, steps[0]) && !edgeNeighbour(u, v, steps[1]) &&
+          !edgeNeighbour(u, v, steps[2]) && !edgeNeighbour(u, v, steps[3])) {
+        continue;
+      }
       const Eigen::Vector3d p = frame.points[i].cast<double>();
-      if (std::abs(n.dot(p) - d) > on_plane) continue;
-      const Eigen::Vector2d si = inPlane(p * (d / n.dot(p)));
+      const Eigen::Vector2d si = inPlane(p * (d / along_[i]));
       // On the docking plane and near the ring (the labels stop short of the edges, so go by geometry here).
       const double radius = (si - r.centre_guess).norm();
       if (radius < g.ring_inner_radius_m - edge_window || radius > g.ring_outer_radius_m + edge_window)
         continue;
-      const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
       for (const auto& step : steps) {
+        if (!edgeNeighbour(u, v, step)) continue;
         const int uj = u + step[0], vj = v + step[1], uk = u - step[0], vk = v - step[1];
-        if (uj < 0 || uj >= width || vj < 0 || vj >= height) continue;
         const int j = vj * width + uj;
         Eigen::Vector3d ray_j;
         if (frame.isValid(j)) {
-          const Eigen::Vector3d pj = frame.points[j].cast<double>();
-          const double behind = d - n.dot(pj);
-          if (behind < on_plane) continue;  // on the plane too, or in front (a petal)
-          ray_j = pj;
+          ray_j = frame.points[j].cast<double>();
         } else {
-          if (uk < 0 || uk >= width || vk < 0 || vk >= height) continue;
-          const int k = vk * width + uk;
-          if (!frame.isValid(k)) continue;
-          const Eigen::Vector3d pk = frame.points[k].cast<double>();
+          const Eigen::Vector3d pk = frame.points[vk * width + uk].cast<double>();
           ray_j = 2.0 * p / p.z() - pk / pk.z();
         }
         const double along = n.dot(ray_j);
@@ -428,21 +450,41 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
       used = 0;
       int outer_used = 0;
       const auto add = [&](const std::vector<Eigen::Vector2d>& pts, int radius_index) {
+        // J = (jx, jy, -1 at radius_index, 0): only H's nonzero terms, in local scalars (H and grad captured
+        // by reference stay in memory and each step waits on the previous store), summed in the same order.
+        double h00 = H(0, 0), h01 = H(0, 1), h11 = H(1, 1), h0r = H(0, radius_index),
+               h1r = H(1, radius_index), hrr = H(radius_index, radius_index);
+        double g0 = grad(0), g1 = grad(1), gr = grad(radius_index);
+        const double x0 = x(0), x1 = x(1), radius_model = x(radius_index);
         for (const Eigen::Vector2d& s : pts) {
-          const Eigen::Vector2d offset = s - x.head<2>();
+          const Eigen::Vector2d offset = s - Eigen::Vector2d(x0, x1);
           const double radius = offset.norm();
           if (radius < 1e-6) continue;
-          const double residual = radius - x(radius_index);
+          const double residual = radius - radius_model;
           if (std::abs(residual) > reject) continue;
-          Eigen::Vector4d J = Eigen::Vector4d::Zero();
-          J.head<2>() = -offset / radius;
-          J(radius_index) = -1.0;
-          H += J * J.transpose();
-          grad += J * residual;
+          const double jx = -offset.x() / radius, jy = -offset.y() / radius;
+          h00 += jx * jx;
+          h01 += jx * jy;
+          h11 += jy * jy;
+          h0r -= jx;
+          h1r -= jy;
+          hrr += 1.0;
+          g0 += jx * residual;
+          g1 += jy * residual;
+          gr -= residual;
           sum_sq += residual * residual;
           ++used;
           outer_used += radius_index == 3 ? 1 : 0;
         }
+        H(0, 0) = h00;
+        H(0, 1) = H(1, 0) = h01;
+        H(1, 1) = h11;
+        H(0, radius_index) = H(radius_index, 0) = h0r;
+        H(1, radius_index) = H(radius_index, 1) = h1r;
+        H(radius_index, radius_index) = hrr;
+        grad(0) = g0;
+        grad(1) = g1;
+        grad(radius_index) = gr;
       };
       add(inner_edge_, 2);
       if (use_outer) add(outer_edge_, 3);

@@ -31,18 +31,28 @@ bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& all_member
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   double count = 0.0;
   for (int pass = 0; pass < 2; ++pass) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    // Sums in scalars, the scatter's upper triangle only: a Matrix3d accumulator stays in memory and every
+    // step waits on the previous store.
+    double sx = 0.0, sy = 0.0, sz = 0.0, sxx = 0.0, sxy = 0.0, sxz = 0.0, syy = 0.0, syz = 0.0, szz = 0.0;
     double n = 0.0;
     for (int i : members) {
       const Eigen::Vector3d p = frame.points[i].cast<double>();
       if (pass == 1 && std::abs(normal.dot(p - mean)) > 3.0 * options.max_planarity_m) continue;
-      sum += p;
-      scatter += p * p.transpose();
+      sx += p.x();
+      sy += p.y();
+      sz += p.z();
+      sxx += p.x() * p.x();
+      sxy += p.x() * p.y();
+      sxz += p.x() * p.z();
+      syy += p.y() * p.y();
+      syz += p.y() * p.z();
+      szz += p.z() * p.z();
       n += 1.0;
     }
     if (n * options.stride * options.stride * step < options.min_cluster_pixels) return false;
-    mean = sum / n;
+    Eigen::Matrix3d scatter;
+    scatter << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
+    mean = Eigen::Vector3d(sx, sy, sz) / n;
     eig.compute(scatter / n - mean * mean.transpose());
     normal = eig.eigenvectors().col(0);
     count = n;
@@ -70,16 +80,26 @@ bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& all_member
   };
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   for (int pass = 0; pass < 2; ++pass) {
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    // The normal equations' sums in scalars (see the plane above).
+    double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0, n = 0.0, bx = 0.0, by = 0.0, b1 = 0.0;
     for (int i : members) {
       if (!onPlane(i)) continue;
       const Eigen::Vector2d s = planar(i);
       if (pass == 1 && std::abs((s - c).norm() - m->radius) > 0.12) continue;
-      const Eigen::Vector3d row(s.x(), s.y(), 1.0);
-      A += row * row.transpose();
-      b -= row * s.squaredNorm();
+      const double s2 = s.squaredNorm();
+      sx += s.x();
+      sy += s.y();
+      sxx += s.x() * s.x();
+      sxy += s.x() * s.y();
+      syy += s.y() * s.y();
+      n += 1.0;
+      bx -= s.x() * s2;
+      by -= s.y() * s2;
+      b1 -= s2;
     }
+    Eigen::Matrix3d A;
+    A << sxx, sxy, sx, sxy, syy, sy, sx, sy, n;
+    const Eigen::Vector3d b(bx, by, b1);
     const Eigen::Vector3d k = A.ldlt().solve(b);
     c = Eigen::Vector2d(-k(0) / 2, -k(1) / 2);
     m->radius = std::sqrt(std::max(0.0, c.squaredNorm() - k(2)));
@@ -121,16 +141,25 @@ bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& all_member
   // Depth step: project the centre into the image with the pinhole fitted to the members' own pixels (u = fx
   // x/z
   // + cx, v likewise), then look at the pixels around it.
-  Eigen::Matrix2d Au = Eigen::Matrix2d::Zero(), Av = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d bu = Eigen::Vector2d::Zero(), bv = Eigen::Vector2d::Zero();
+  double su = 0.0, suu = 0.0, sv = 0.0, svv = 0.0, n = 0.0, bu0 = 0.0, bu1 = 0.0, bv0 = 0.0, bv1 = 0.0;
   for (int i : members) {
     const Eigen::Vector3f& p = frame.points[i];
-    const Eigen::Vector2d xu(p.x() / p.z(), 1.0), xv(p.y() / p.z(), 1.0);
-    Au += xu * xu.transpose();
-    bu += xu * static_cast<double>(i % frame.width);
-    Av += xv * xv.transpose();
-    bv += xv * static_cast<double>(i / frame.width);
+    const double xu = p.x() / p.z(), xv = p.y() / p.z();
+    const double u = i % frame.width, v = i / frame.width;
+    su += xu;
+    suu += xu * xu;
+    sv += xv;
+    svv += xv * xv;
+    n += 1.0;
+    bu0 += xu * u;
+    bu1 += u;
+    bv0 += xv * v;
+    bv1 += v;
   }
+  Eigen::Matrix2d Au, Av;
+  Au << suu, su, su, n;
+  Av << svv, sv, sv, n;
+  const Eigen::Vector2d bu(bu0, bu1), bv(bv0, bv1);
   const Eigen::Vector2d pu = Au.ldlt().solve(bu), pv = Av.ldlt().solve(bv);
   const int uc = static_cast<int>(std::lround(pu(0) * m->centre.x() / m->centre.z() + pu(1)));
   const int vc = static_cast<int>(std::lround(pv(0) * m->centre.y() / m->centre.z() + pv(1)));
@@ -151,37 +180,45 @@ bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& all_member
 
 }  // namespace
 
-void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, RingDetection* detection) {
+void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, RingDetection* detection,
+                RingDetectorScratch* scratch) {
   *detection = RingDetection();
   const int width = frame.width, height = frame.height, n = width * height;
   // Clusters grow over every stride-th pixel in both directions (the ring is tens of pixels wide down to 7
   // m); the ring's pixels are filled in at full resolution at the end.
   const int stride = options.stride;
-  std::vector<int> label(n, -1);
-  std::vector<int> members;
-  members.reserve(n / (stride * stride) + 1);
+  std::vector<int>& label = scratch->label;
+  label.assign(n, -1);
+  std::vector<int>& members = scratch->members;
+  // Each member's image row, kept beside it: an integer division per pixel cost as much as the growing.
+  std::vector<int>& rows = scratch->rows;
   int next_label = 0;
   for (int v0 = 0; v0 < height; v0 += stride) {
     for (int u0 = 0; u0 < width; u0 += stride) {
       const int seed = v0 * width + u0;
       if (label[seed] >= 0 || !frame.isValid(seed)) continue;
       members.clear();
+      rows.clear();
       members.push_back(seed);
+      rows.push_back(v0);
       label[seed] = next_label;
       for (std::size_t head = 0; head < members.size(); ++head) {
         const int i = members[head];
-        const int u = i % width, v = i / width;
+        const int v = rows[head], u = i - v * width;
         const float r = frame.range_m[i];
         const float step = static_cast<float>(
             options.connect_step_m + stride * r * options.fit.pixel_pitch_rad * options.slope_allowance);
         const int neighbours[4] = {u >= stride ? i - stride : -1, u + stride < width ? i + stride : -1,
                                    v >= stride ? i - stride * width : -1,
                                    v + stride < height ? i + stride * width : -1};
-        for (int j : neighbours) {
+        const int neighbour_rows[4] = {v, v, v - stride, v + stride};
+        for (int k = 0; k < 4; ++k) {
+          const int j = neighbours[k];
           if (j < 0 || label[j] >= 0 || !frame.isValid(j)) continue;
           if (std::abs(frame.range_m[j] - r) > step) continue;
           label[j] = next_label;
           members.push_back(j);
+          rows.push_back(neighbour_rows[k]);
         }
       }
       ++next_label;
@@ -222,7 +259,7 @@ PoseResult RingMethod::estimate(const OrganizedCloud& cloud,
                                 const Eigen::Isometry3d& T_lidar_target_predicted) {
   prepareFrame(cloud, options_.fit, &frame_);
   const Eigen::Isometry3d T_lidar_port_prior = T_lidar_target_predicted * fitter_.geometry().T_target_port;
-  detectRing(frame_, options_, &detection_);
+  detectRing(frame_, options_, &detection_, &scratch_);
   if (!detection_.found) {
     // The terminal stage: hatch and centreline target from the prediction.
     return fitter_.fit(frame_, {}, T_lidar_port_prior, T_lidar_port_prior, EstimateMethod::kRing, &report_);

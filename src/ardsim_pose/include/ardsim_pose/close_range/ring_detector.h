@@ -62,8 +62,14 @@ struct RingDetection {
   double depth_step_m = 0.0;
 };
 
+// Buffers of detectRing, reused between frames (no allocation per frame).
+struct RingDetectorScratch {
+  std::vector<int> label, members, rows;
+};
+
 // Cluster and score; fills detection (found false when no cluster meets the criteria).
-void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, RingDetection* detection);
+void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, RingDetection* detection,
+                RingDetectorScratch* scratch);
 
 class RingMethod : public PoseMethod {
  public:
@@ -81,6 +87,7 @@ class RingMethod : public PoseMethod {
   AdapterFitter fitter_;
   PreparedFrame frame_;
   RingDetection detection_;
+  RingDetectorScratch scratch_;
   AdapterFitReport report_;
 };
 
