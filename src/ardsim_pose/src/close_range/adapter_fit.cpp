@@ -102,7 +102,7 @@ AdapterFitter::AdapterFitter(const AdapterGeometry& geometry, const AdapterFitOp
     : geometry_(geometry), options_(options) {}
 
 void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                                     const Eigen::Isometry3d& T_lidar_port, double band) {
+                                     const Eigen::Isometry3d& T_lidar_port, double band, int stride) {
   const AdapterGeometry& g = geometry_;
   const double face_x[kFaces] = {0.0, g.tunnel_face_x_m, g.hatch_face_x_m, g.plate_face_x_m,
                                  g.cross_face_x_m};
@@ -123,33 +123,36 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
   is_ring_.assign(n, 0);
   for (int i : ring_face_pixels) is_ring_[i] = 1;
   const bool ring_from_model = ring_face_pixels.empty();
-  for (int i = 0; i < n; ++i) {
-    if (!frame.isValid(i)) continue;
-    const Eigen::Vector3d p = frame.points[i].cast<double>();
-    const Eigen::Vector3d q = R * p + t;
-    const double r2 = q.y() * q.y() + q.z() * q.z();
-    const bool off_cross = std::abs(q.y()) > 0.04 && std::abs(q.z()) > 0.04;
-    int face = -1;
-    if (is_ring_[i]) {
-      face = 0;
-    } else if (ring_from_model && std::abs(q.x()) < band && r2 > ring_in && r2 < ring_out) {
-      face = 0;
-      is_ring_[i] = 1;
-    } else if (std::abs(q.x() - face_x[1]) < band && r2 > tunnel_in && r2 < tunnel_out) {
-      face = 1;
-    } else if (std::abs(q.x() - face_x[2]) < band && r2 > hatch_in && r2 < hatch_out && off_cross) {
-      face = 2;
-    } else if (std::abs(q.x() - face_x[3]) < band && r2 < plate_out && off_cross) {
-      face = 3;
-    } else if (std::abs(q.x() - face_x[4]) < band && r2 < cross_out) {
-      face = 4;
+  for (int v = 0; v < frame.height; v += stride) {
+    for (int u = 0; u < frame.width; u += stride) {
+      const int i = v * frame.width + u;
+      if (!frame.isValid(i)) continue;
+      const Eigen::Vector3d p = frame.points[i].cast<double>();
+      const Eigen::Vector3d q = R * p + t;
+      const double r2 = q.y() * q.y() + q.z() * q.z();
+      const bool off_cross = std::abs(q.y()) > 0.04 && std::abs(q.z()) > 0.04;
+      int face = -1;
+      if (is_ring_[i]) {
+        face = 0;
+      } else if (ring_from_model && std::abs(q.x()) < band && r2 > ring_in && r2 < ring_out) {
+        face = 0;
+        is_ring_[i] = 1;
+      } else if (std::abs(q.x() - face_x[1]) < band && r2 > tunnel_in && r2 < tunnel_out) {
+        face = 1;
+      } else if (std::abs(q.x() - face_x[2]) < band && r2 > hatch_in && r2 < hatch_out && off_cross) {
+        face = 2;
+      } else if (std::abs(q.x() - face_x[3]) < band && r2 < plate_out && off_cross) {
+        face = 3;
+      } else if (std::abs(q.x() - face_x[4]) < band && r2 < cross_out) {
+        face = 4;
+      }
+      if (face >= 0) plane_points_.push_back({p, face_x[face], face, i});
     }
-    if (face >= 0) plane_points_.push_back({p, face_x[face], face, i});
   }
 }
 
-bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* normal, double* offset,
-                              double* rms, int* used) {
+bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen::Vector3d* normal,
+                              double* offset, double* rms, int* used) {
   // Each face's points enter the least squares only through their sums (count, sum of p, sum of p p^T), so
   // the Gauss-Newton steps cost nothing per point; the points are visited once per rejection scale: wide
   // first (the seed may be off by centimetres), then a few sigma.
@@ -193,7 +196,7 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
       const std::array<double, 6>& u = f.upper;
       f.scatter << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
     }
-    if (inliers * static_cast<int>(step) < options_.min_plane_points) return false;
+    if (inliers * static_cast<int>(step) * stride * stride < options_.min_plane_points) return false;
     *rms = std::sqrt(sum_sq / inliers);
     *used = inliers;
     for (int step = 0; step < 3; ++step) {
@@ -328,17 +331,17 @@ bool AdapterFitter::fitCross(const std::vector<Eigen::Vector2d>& points, Eigen::
 }
 
 bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                             const Eigen::Isometry3d& T_lidar_port_guess, double band, RoundResult* out,
-                             std::string* reason) {
+                             const Eigen::Isometry3d& T_lidar_port_guess, double band, int stride,
+                             RoundResult* out, std::string* reason) {
   const AdapterGeometry& g = geometry_;
   RoundResult& r = *out;
   r = RoundResult();
 
   // 1. The adapter's faces and the joint plane fit.
-  labelPlanePoints(frame, ring_face_pixels, T_lidar_port_guess, band);
+  labelPlanePoints(frame, ring_face_pixels, T_lidar_port_guess, band, stride);
   r.n = T_lidar_port_guess.linear().col(0);
   r.d = r.n.dot(T_lidar_port_guess.translation());
-  if (!fitPlanes(plane_points_, &r.n, &r.d, &r.report.plane_rms_m, &r.report.plane_points)) {
+  if (!fitPlanes(plane_points_, stride, &r.n, &r.d, &r.report.plane_rms_m, &r.report.plane_points)) {
     *reason = "adapter faces not found (" + std::to_string(plane_points_.size()) + " points)";
     return false;
   }
@@ -370,9 +373,14 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   inner_edge_.clear();
   outer_edge_.clear();
   const int width = frame.width, height = frame.height;
-  // n.p of every pixel, once: each is read again as a neighbour of four.
+  // n.p of every pixel scanned and of its four neighbours, once: each is read again as a neighbour of four.
+  // The edge points keep full resolution at any stride: a scanned pixel is paired with its adjacent pixels.
   along_.resize(frame.points.size());
-  for (std::size_t i = 0; i < frame.points.size(); ++i) along_[i] = n.dot(frame.points[i].cast<double>());
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; u += v % stride == 0 ? 1 : stride) {
+      along_[v * width + u] = n.dot(frame.points[v * width + u].cast<double>());
+    }
+  }
   const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
   // Whether the neighbour in direction step can make pixel (u, v) an edge: behind the plane, or no return
   // with a return beyond it to extrapolate from.
@@ -383,8 +391,8 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
     if (frame.isValid(j)) return d - along_[j] >= on_plane;
     return uk >= 0 && uk < width && vk >= 0 && vk < height && frame.isValid(vk * width + uk);
   };
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
+  for (int v = 0; v < height; v += stride) {
+    for (int u = 0; u < width; u += stride) {
       const int i = v * width + u;
       if (!frame.isValid(i)) continue;
       if (std::abs(along_[i] - d) > on_plane) continue;
@@ -582,9 +590,12 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   // A first round that found the plane but not the centre (the seed's range or tilt was off by a good part of
   // the band) gets a second chance with the plane it found.
   for (int round = 0; round < 2; ++round) {
-    const bool ok =
-        fitRound(frame, ring_face_pixels, T_guess,
-                 round == 0 ? options_.plane_band_m : 0.6 * options_.plane_band_m, &r, &result.reason);
+    // The first round only brings the guess near: every second pixel in u and v, a quarter of the cost (its
+    // minimum edge and cross counts are not scaled down: a circle or cross it cannot back well enough leaves
+    // the plane-only second chance).
+    const bool ok = fitRound(frame, ring_face_pixels, T_guess,
+                             round == 0 ? options_.plane_band_m : 0.6 * options_.plane_band_m,
+                             round == 0 ? 2 : 1, &r, &result.reason);
     if (!ok && (round == 1 || r.report.plane_points == 0)) return finish(result);
     T_guess.linear() = portRotation(r.n, seed_boresight);
     T_guess.translation() = ok ? r.centre : r.origin;
