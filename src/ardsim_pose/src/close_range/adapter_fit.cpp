@@ -616,9 +616,12 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   };
   std::vector<AnglePoint> petal_points;
   std::complex<double> petal_sum = 0.0;
+  // q.x() below is n.p - d up to rounding, and the last round left n.p of every pixel in along_: most pixels
+  // are rejected on it (with a margin far above the rounding) before the transform.
+  const double along_min = r.d + on_plane - 1e-6, along_max = r.d + g.petal_top_x_m + 0.02 + 1e-6;
   const int pixels = frame.width * frame.height;
   for (int i = 0; i < pixels; ++i) {
-    if (!frame.isValid(i)) continue;
+    if (!frame.isValid(i) || along_[i] <= along_min || along_[i] >= along_max) continue;
     const Eigen::Vector3d q = T_port0_lidar * frame.points[i].cast<double>();
     if (q.x() <= on_plane || q.x() >= g.petal_top_x_m + 0.02) continue;
     const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
