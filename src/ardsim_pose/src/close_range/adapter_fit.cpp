@@ -128,13 +128,16 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
       const int i = v * frame.width + u;
       if (!frame.isValid(i)) continue;
       const Eigen::Vector3d p = frame.points[i].cast<double>();
+      // The front end's ring pixels (a good part of the frame) need no transform.
+      if (is_ring_[i]) {
+        plane_points_.push_back({p, face_x[0], 0, i});
+        continue;
+      }
       const Eigen::Vector3d q = R * p + t;
       const double r2 = q.y() * q.y() + q.z() * q.z();
       const bool off_cross = std::abs(q.y()) > 0.04 && std::abs(q.z()) > 0.04;
       int face = -1;
-      if (is_ring_[i]) {
-        face = 0;
-      } else if (ring_from_model && std::abs(q.x()) < band && r2 > ring_in && r2 < ring_out) {
+      if (ring_from_model && std::abs(q.x()) < band && r2 > ring_in && r2 < ring_out) {
         face = 0;
         is_ring_[i] = 1;
       } else if (std::abs(q.x() - face_x[1]) < band && r2 > tunnel_in && r2 < tunnel_out) {
