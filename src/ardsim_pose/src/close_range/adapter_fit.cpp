@@ -177,24 +177,54 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen
     std::array<FaceSums, kFaces> faces;
     double sum_sq = 0.0;
     int inliers = 0;
+    // The current face's sums in local scalars (faces[face] in memory made each step wait on the previous
+    // store), swapped in and out where the face changes (a few times per image row); every face's sums still
+    // add its points in the same order.
+    int current = -1;
+    double count = 0.0, s0 = 0.0, s1 = 0.0, s2 = 0.0, u0 = 0.0, u1 = 0.0, u2 = 0.0, u3 = 0.0, u4 = 0.0,
+           u5 = 0.0;
+    const auto store = [&]() {
+      if (current < 0) return;
+      FaceSums& f = faces[current];
+      f.count = count;
+      f.sum = Eigen::Vector3d(s0, s1, s2);
+      f.upper = {u0, u1, u2, u3, u4, u5};
+    };
     for (std::size_t k = 0; k < points.size(); k += step) {
       const PlanePoint& pp = points[k];
       const double residual = n.dot(pp.p) - d - pp.face_x;
       if (std::abs(residual) > reject) continue;
-      FaceSums& f = faces[pp.face];
-      f.x = pp.face_x;
-      f.count += 1.0;
-      f.sum += pp.p;
+      if (pp.face != current) {
+        store();
+        current = pp.face;
+        FaceSums& f = faces[current];
+        f.x = pp.face_x;
+        count = f.count;
+        s0 = f.sum.x();
+        s1 = f.sum.y();
+        s2 = f.sum.z();
+        u0 = f.upper[0];
+        u1 = f.upper[1];
+        u2 = f.upper[2];
+        u3 = f.upper[3];
+        u4 = f.upper[4];
+        u5 = f.upper[5];
+      }
       const Eigen::Vector3d& p = pp.p;
-      f.upper[0] += p.x() * p.x();
-      f.upper[1] += p.x() * p.y();
-      f.upper[2] += p.x() * p.z();
-      f.upper[3] += p.y() * p.y();
-      f.upper[4] += p.y() * p.z();
-      f.upper[5] += p.z() * p.z();
+      count += 1.0;
+      s0 += p.x();
+      s1 += p.y();
+      s2 += p.z();
+      u0 += p.x() * p.x();
+      u1 += p.x() * p.y();
+      u2 += p.x() * p.z();
+      u3 += p.y() * p.y();
+      u4 += p.y() * p.z();
+      u5 += p.z() * p.z();
       sum_sq += residual * residual;
       ++inliers;
     }
+    store();
     for (FaceSums& f : faces) {
       const std::array<double, 6>& u = f.upper;
       f.scatter << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
