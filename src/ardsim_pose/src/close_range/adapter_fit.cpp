@@ -645,6 +645,7 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   const Eigen::Isometry3d T_port0_lidar = T_plane.inverse();
   struct AnglePoint {
     double angle;
+    std::complex<double> unit3;  // at 3 x angle, kept for the per-petal sums (a sincos each)
     bool border;
   };
   std::vector<AnglePoint> petal_points;
@@ -660,8 +661,8 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
     const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
     if (radius > g.petal_min_radius_m && radius < g.petal_max_radius_m) {
       const double angle = std::atan2(q.z(), q.y());
-      petal_points.push_back({angle, onBorder(frame, i)});
-      petal_sum += std::polar(1.0, 3.0 * angle);
+      petal_points.push_back({angle, std::polar(1.0, 3.0 * angle), onBorder(frame, i)});
+      petal_sum += petal_points.back().unit3;
     }
   }
   // Per petal (nearest branch of the first estimate), drop those touching the border, then the mean again.
@@ -672,7 +673,7 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   for (const AnglePoint& a : petal_points) {
     const int k =
         ((static_cast<int>(std::lround(wrapPi(a.angle - petal_first) / (2.0 * M_PI / 3.0))) % 3) + 3) % 3;
-    per_petal[k] += std::polar(1.0, 3.0 * a.angle);
+    per_petal[k] += a.unit3;
     ++per_petal_count[k];
     per_petal_border[k] = per_petal_border[k] || a.border;
   }
