@@ -120,6 +120,7 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
   const Eigen::Vector3d t = T_port_lidar.translation();
   const int n = frame.width * frame.height;
   plane_points_.clear();
+  cross_face_points_.clear();
   is_ring_.assign(n, 0);
   for (int i : ring_face_pixels) is_ring_[i] = 1;
   const bool ring_from_model = ring_face_pixels.empty();
@@ -149,6 +150,7 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
       } else if (std::abs(q.x() - face_x[4]) < band && r2 < cross_out) {
         face = 4;
       }
+      if (face == 4) cross_face_points_.push_back(static_cast<int>(plane_points_.size()));
       if (face >= 0) plane_points_.push_back({p, face_x[face], face, i});
     }
   }
@@ -555,10 +557,9 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   // points near it), and the cross's centre is where the two lines meet: unbiased when the field of view
   // clips the arms' ends, as it does near contact with the chaser tilted.
   cross_points_.clear();
-  for (const PlanePoint& pp : plane_points_) {
-    if (pp.face_x == g.cross_face_x_m && std::abs(n.dot(pp.p) - d - pp.face_x) <= on_plane) {
-      cross_points_.push_back(inPlane(pp.p));
-    }
+  for (int k : cross_face_points_) {
+    const PlanePoint& pp = plane_points_[k];
+    if (std::abs(n.dot(pp.p) - d - pp.face_x) <= on_plane) cross_points_.push_back(inPlane(pp.p));
   }
   r.report.cross_points = static_cast<int>(cross_points_.size());
   Eigen::Vector2d cross_centre = r.centre_guess;

@@ -163,6 +163,7 @@ class AdapterFitter {
   AdapterGeometry geometry_;
   AdapterFitOptions options_;
   std::vector<PlanePoint> plane_points_;
+  std::vector<int> cross_face_points_;  // indices into plane_points_ of the cross face's points
   std::vector<std::uint8_t> is_ring_;
   std::vector<double> along_;  // n.p of each pixel for the ring-edge scan
   std::vector<Eigen::Vector2d> inner_edge_, outer_edge_, cross_points_;
