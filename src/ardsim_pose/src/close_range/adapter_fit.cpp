@@ -58,25 +58,24 @@ void prepareFrame(const OrganizedCloud& cloud, const AdapterFitOptions& options,
     std::fill(frame->range_m.begin(), frame->range_m.end(), nan);
     return;
   }
+  const bool correct = has_intensity && options.saturated_range_bias_m != 0.0;
+  const float bias = static_cast<float>(options.saturated_range_bias_m);
+  int valid_count = 0;
+  // Selects rather than branches (returns, misses and saturated pixels interleave unpredictably); a scale of
+  // 1 leaves a point as it is.
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3f& p = cloud.points[i];
     const float r = p.norm();
-    if (!std::isfinite(r) || r <= 0.0f) {
-      frame->points[i] = Eigen::Vector3f::Constant(nan);
-      frame->range_m[i] = nan;
-      continue;
-    }
+    const bool valid = std::isfinite(r) && r > 0.0f;
     // Saturated returns read short by the detector walk: put it back along the ray.
-    if (has_intensity && options.saturated_range_bias_m != 0.0 && cloud.intensity[i] >= 1.0f) {
-      const float corrected = r - static_cast<float>(options.saturated_range_bias_m);
-      frame->points[i] = p * (corrected / r);
-      frame->range_m[i] = corrected;
-    } else {
-      frame->points[i] = p;
-      frame->range_m[i] = r;
-    }
-    ++frame->valid_count;
+    const bool saturated = correct && cloud.intensity[i] >= 1.0f;
+    const float range = saturated ? r - bias : r;
+    const float scale = saturated ? range / r : 1.0f;
+    frame->points[i] = valid ? Eigen::Vector3f(p * scale) : Eigen::Vector3f::Constant(nan);
+    frame->range_m[i] = valid ? range : nan;
+    valid_count += valid ? 1 : 0;
   }
+  frame->valid_count = valid_count;
 }
 
 double boresightAngle(const Eigen::Matrix3d& R_lidar_port) {
