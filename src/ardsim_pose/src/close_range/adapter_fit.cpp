@@ -58,25 +58,24 @@ void prepareFrame(const OrganizedCloud& cloud, const AdapterFitOptions& options,
     std::fill(frame->range_m.begin(), frame->range_m.end(), nan);
     return;
   }
+  const bool correct = has_intensity && options.saturated_range_bias_m != 0.0;
+  const float bias = static_cast<float>(options.saturated_range_bias_m);
+  int valid_count = 0;
+  // Selects rather than branches (returns, misses and saturated pixels interleave unpredictably); a scale of
+  // 1 leaves a point as it is.
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3f& p = cloud.points[i];
     const float r = p.norm();
-    if (!std::isfinite(r) || r <= 0.0f) {
-      frame->points[i] = Eigen::Vector3f::Constant(nan);
-      frame->range_m[i] = nan;
-      continue;
-    }
+    const bool valid = std::isfinite(r) && r > 0.0f;
     // Saturated returns read short by the detector walk: put it back along the ray.
-    if (has_intensity && options.saturated_range_bias_m != 0.0 && cloud.intensity[i] >= 1.0f) {
-      const float corrected = r - static_cast<float>(options.saturated_range_bias_m);
-      frame->points[i] = p * (corrected / r);
-      frame->range_m[i] = corrected;
-    } else {
-      frame->points[i] = p;
-      frame->range_m[i] = r;
-    }
-    ++frame->valid_count;
+    const bool saturated = correct && cloud.intensity[i] >= 1.0f;
+    const float range = saturated ? r - bias : r;
+    const float scale = saturated ? range / r : 1.0f;
+    frame->points[i] = valid ? Eigen::Vector3f(p * scale) : Eigen::Vector3f::Constant(nan);
+    frame->range_m[i] = valid ? range : nan;
+    valid_count += valid ? 1 : 0;
   }
+  frame->valid_count = valid_count;
 }
 
 double boresightAngle(const Eigen::Matrix3d& R_lidar_port) {
@@ -102,7 +101,7 @@ AdapterFitter::AdapterFitter(const AdapterGeometry& geometry, const AdapterFitOp
     : geometry_(geometry), options_(options) {}
 
 void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                                     const Eigen::Isometry3d& T_lidar_port, double band) {
+                                     const Eigen::Isometry3d& T_lidar_port, double band, int stride) {
   const AdapterGeometry& g = geometry_;
   const double face_x[kFaces] = {0.0, g.tunnel_face_x_m, g.hatch_face_x_m, g.plate_face_x_m,
                                  g.cross_face_x_m};
@@ -120,36 +119,44 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
   const Eigen::Vector3d t = T_port_lidar.translation();
   const int n = frame.width * frame.height;
   plane_points_.clear();
+  cross_face_points_.clear();
   is_ring_.assign(n, 0);
   for (int i : ring_face_pixels) is_ring_[i] = 1;
   const bool ring_from_model = ring_face_pixels.empty();
-  for (int i = 0; i < n; ++i) {
-    if (!frame.isValid(i)) continue;
-    const Eigen::Vector3d p = frame.points[i].cast<double>();
-    const Eigen::Vector3d q = R * p + t;
-    const double r2 = q.y() * q.y() + q.z() * q.z();
-    const bool off_cross = std::abs(q.y()) > 0.04 && std::abs(q.z()) > 0.04;
-    int face = -1;
-    if (is_ring_[i]) {
-      face = 0;
-    } else if (ring_from_model && std::abs(q.x()) < band && r2 > ring_in && r2 < ring_out) {
-      face = 0;
-      is_ring_[i] = 1;
-    } else if (std::abs(q.x() - face_x[1]) < band && r2 > tunnel_in && r2 < tunnel_out) {
-      face = 1;
-    } else if (std::abs(q.x() - face_x[2]) < band && r2 > hatch_in && r2 < hatch_out && off_cross) {
-      face = 2;
-    } else if (std::abs(q.x() - face_x[3]) < band && r2 < plate_out && off_cross) {
-      face = 3;
-    } else if (std::abs(q.x() - face_x[4]) < band && r2 < cross_out) {
-      face = 4;
+  for (int v = 0; v < frame.height; v += stride) {
+    for (int u = 0; u < frame.width; u += stride) {
+      const int i = v * frame.width + u;
+      if (!frame.isValid(i)) continue;
+      const Eigen::Vector3d p = frame.points[i].cast<double>();
+      // The front end's ring pixels (a good part of the frame) need no transform.
+      if (is_ring_[i]) {
+        plane_points_.push_back({p, face_x[0], 0, i});
+        continue;
+      }
+      const Eigen::Vector3d q = R * p + t;
+      const double r2 = q.y() * q.y() + q.z() * q.z();
+      const bool off_cross = std::abs(q.y()) > 0.04 && std::abs(q.z()) > 0.04;
+      int face = -1;
+      if (ring_from_model && std::abs(q.x()) < band && r2 > ring_in && r2 < ring_out) {
+        face = 0;
+        is_ring_[i] = 1;
+      } else if (std::abs(q.x() - face_x[1]) < band && r2 > tunnel_in && r2 < tunnel_out) {
+        face = 1;
+      } else if (std::abs(q.x() - face_x[2]) < band && r2 > hatch_in && r2 < hatch_out && off_cross) {
+        face = 2;
+      } else if (std::abs(q.x() - face_x[3]) < band && r2 < plate_out && off_cross) {
+        face = 3;
+      } else if (std::abs(q.x() - face_x[4]) < band && r2 < cross_out) {
+        face = 4;
+      }
+      if (face == 4) cross_face_points_.push_back(static_cast<int>(plane_points_.size()));
+      if (face >= 0) plane_points_.push_back({p, face_x[face], face, i});
     }
-    if (face >= 0) plane_points_.push_back({p, face_x[face], face, i});
   }
 }
 
-bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* normal, double* offset,
-                              double* rms, int* used) {
+bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen::Vector3d* normal,
+                              double* offset, double* rms, int* used) {
   // Each face's points enter the least squares only through their sums (count, sum of p, sum of p p^T), so
   // the Gauss-Newton steps cost nothing per point; the points are visited once per rejection scale: wide
   // first (the seed may be off by centimetres), then a few sigma.
@@ -171,29 +178,59 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* 
     std::array<FaceSums, kFaces> faces;
     double sum_sq = 0.0;
     int inliers = 0;
+    // The current face's sums in local scalars (faces[face] in memory made each step wait on the previous
+    // store), swapped in and out where the face changes (a few times per image row); every face's sums still
+    // add its points in the same order.
+    int current = -1;
+    double count = 0.0, s0 = 0.0, s1 = 0.0, s2 = 0.0, u0 = 0.0, u1 = 0.0, u2 = 0.0, u3 = 0.0, u4 = 0.0,
+           u5 = 0.0;
+    const auto store = [&]() {
+      if (current < 0) return;
+      FaceSums& f = faces[current];
+      f.count = count;
+      f.sum = Eigen::Vector3d(s0, s1, s2);
+      f.upper = {u0, u1, u2, u3, u4, u5};
+    };
     for (std::size_t k = 0; k < points.size(); k += step) {
       const PlanePoint& pp = points[k];
       const double residual = n.dot(pp.p) - d - pp.face_x;
       if (std::abs(residual) > reject) continue;
-      FaceSums& f = faces[pp.face];
-      f.x = pp.face_x;
-      f.count += 1.0;
-      f.sum += pp.p;
+      if (pp.face != current) {
+        store();
+        current = pp.face;
+        FaceSums& f = faces[current];
+        f.x = pp.face_x;
+        count = f.count;
+        s0 = f.sum.x();
+        s1 = f.sum.y();
+        s2 = f.sum.z();
+        u0 = f.upper[0];
+        u1 = f.upper[1];
+        u2 = f.upper[2];
+        u3 = f.upper[3];
+        u4 = f.upper[4];
+        u5 = f.upper[5];
+      }
       const Eigen::Vector3d& p = pp.p;
-      f.upper[0] += p.x() * p.x();
-      f.upper[1] += p.x() * p.y();
-      f.upper[2] += p.x() * p.z();
-      f.upper[3] += p.y() * p.y();
-      f.upper[4] += p.y() * p.z();
-      f.upper[5] += p.z() * p.z();
+      count += 1.0;
+      s0 += p.x();
+      s1 += p.y();
+      s2 += p.z();
+      u0 += p.x() * p.x();
+      u1 += p.x() * p.y();
+      u2 += p.x() * p.z();
+      u3 += p.y() * p.y();
+      u4 += p.y() * p.z();
+      u5 += p.z() * p.z();
       sum_sq += residual * residual;
       ++inliers;
     }
+    store();
     for (FaceSums& f : faces) {
       const std::array<double, 6>& u = f.upper;
       f.scatter << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
     }
-    if (inliers * static_cast<int>(step) < options_.min_plane_points) return false;
+    if (inliers * static_cast<int>(step) * stride * stride < options_.min_plane_points) return false;
     *rms = std::sqrt(sum_sq / inliers);
     *used = inliers;
     for (int step = 0; step < 3; ++step) {
@@ -328,17 +365,17 @@ bool AdapterFitter::fitCross(const std::vector<Eigen::Vector2d>& points, Eigen::
 }
 
 bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                             const Eigen::Isometry3d& T_lidar_port_guess, double band, RoundResult* out,
-                             std::string* reason) {
+                             const Eigen::Isometry3d& T_lidar_port_guess, double band, int stride,
+                             RoundResult* out, std::string* reason) {
   const AdapterGeometry& g = geometry_;
   RoundResult& r = *out;
   r = RoundResult();
 
   // 1. The adapter's faces and the joint plane fit.
-  labelPlanePoints(frame, ring_face_pixels, T_lidar_port_guess, band);
+  labelPlanePoints(frame, ring_face_pixels, T_lidar_port_guess, band, stride);
   r.n = T_lidar_port_guess.linear().col(0);
   r.d = r.n.dot(T_lidar_port_guess.translation());
-  if (!fitPlanes(plane_points_, &r.n, &r.d, &r.report.plane_rms_m, &r.report.plane_points)) {
+  if (!fitPlanes(plane_points_, stride, &r.n, &r.d, &r.report.plane_rms_m, &r.report.plane_points)) {
     *reason = "adapter faces not found (" + std::to_string(plane_points_.size()) + " points)";
     return false;
   }
@@ -370,9 +407,14 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   inner_edge_.clear();
   outer_edge_.clear();
   const int width = frame.width, height = frame.height;
-  // n.p of every pixel, once: each is read again as a neighbour of four.
+  // n.p of every pixel scanned and of its four neighbours, once: each is read again as a neighbour of four.
+  // The edge points keep full resolution at any stride: a scanned pixel is paired with its adjacent pixels.
   along_.resize(frame.points.size());
-  for (std::size_t i = 0; i < frame.points.size(); ++i) along_[i] = n.dot(frame.points[i].cast<double>());
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; u += v % stride == 0 ? 1 : stride) {
+      along_[v * width + u] = n.dot(frame.points[v * width + u].cast<double>());
+    }
+  }
   const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
   // Whether the neighbour in direction step can make pixel (u, v) an edge: behind the plane, or no return
   // with a return beyond it to extrapolate from.
@@ -383,8 +425,8 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
     if (frame.isValid(j)) return d - along_[j] >= on_plane;
     return uk >= 0 && uk < width && vk >= 0 && vk < height && frame.isValid(vk * width + uk);
   };
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
+  for (int v = 0; v < height; v += stride) {
+    for (int u = 0; u < width; u += stride) {
       const int i = v * width + u;
       if (!frame.isValid(i)) continue;
       if (std::abs(along_[i] - d) > on_plane) continue;
@@ -514,10 +556,9 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   // points near it), and the cross's centre is where the two lines meet: unbiased when the field of view
   // clips the arms' ends, as it does near contact with the chaser tilted.
   cross_points_.clear();
-  for (const PlanePoint& pp : plane_points_) {
-    if (pp.face_x == g.cross_face_x_m && std::abs(n.dot(pp.p) - d - pp.face_x) <= on_plane) {
-      cross_points_.push_back(inPlane(pp.p));
-    }
+  for (int k : cross_face_points_) {
+    const PlanePoint& pp = plane_points_[k];
+    if (std::abs(n.dot(pp.p) - d - pp.face_x) <= on_plane) cross_points_.push_back(inPlane(pp.p));
   }
   r.report.cross_points = static_cast<int>(cross_points_.size());
   Eigen::Vector2d cross_centre = r.centre_guess;
@@ -582,9 +623,12 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   // A first round that found the plane but not the centre (the seed's range or tilt was off by a good part of
   // the band) gets a second chance with the plane it found.
   for (int round = 0; round < 2; ++round) {
-    const bool ok =
-        fitRound(frame, ring_face_pixels, T_guess,
-                 round == 0 ? options_.plane_band_m : 0.6 * options_.plane_band_m, &r, &result.reason);
+    // The first round only brings the guess near: every second pixel in u and v, a quarter of the cost (its
+    // minimum edge and cross counts are not scaled down: a circle or cross it cannot back well enough leaves
+    // the plane-only second chance).
+    const bool ok = fitRound(frame, ring_face_pixels, T_guess,
+                             round == 0 ? options_.plane_band_m : 0.6 * options_.plane_band_m,
+                             round == 0 ? 2 : 1, &r, &result.reason);
     if (!ok && (round == 1 || r.report.plane_points == 0)) return finish(result);
     T_guess.linear() = portRotation(r.n, seed_boresight);
     T_guess.translation() = ok ? r.centre : r.origin;
@@ -601,20 +645,24 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   const Eigen::Isometry3d T_port0_lidar = T_plane.inverse();
   struct AnglePoint {
     double angle;
+    std::complex<double> unit3;  // at 3 x angle, kept for the per-petal sums (a sincos each)
     bool border;
   };
   std::vector<AnglePoint> petal_points;
   std::complex<double> petal_sum = 0.0;
+  // q.x() below is n.p - d up to rounding, and the last round left n.p of every pixel in along_: most pixels
+  // are rejected on it (with a margin far above the rounding) before the transform.
+  const double along_min = r.d + on_plane - 1e-6, along_max = r.d + g.petal_top_x_m + 0.02 + 1e-6;
   const int pixels = frame.width * frame.height;
   for (int i = 0; i < pixels; ++i) {
-    if (!frame.isValid(i)) continue;
+    if (!frame.isValid(i) || along_[i] <= along_min || along_[i] >= along_max) continue;
     const Eigen::Vector3d q = T_port0_lidar * frame.points[i].cast<double>();
     if (q.x() <= on_plane || q.x() >= g.petal_top_x_m + 0.02) continue;
     const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
     if (radius > g.petal_min_radius_m && radius < g.petal_max_radius_m) {
       const double angle = std::atan2(q.z(), q.y());
-      petal_points.push_back({angle, onBorder(frame, i)});
-      petal_sum += std::polar(1.0, 3.0 * angle);
+      petal_points.push_back({angle, std::polar(1.0, 3.0 * angle), onBorder(frame, i)});
+      petal_sum += petal_points.back().unit3;
     }
   }
   // Per petal (nearest branch of the first estimate), drop those touching the border, then the mean again.
@@ -625,7 +673,7 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   for (const AnglePoint& a : petal_points) {
     const int k =
         ((static_cast<int>(std::lround(wrapPi(a.angle - petal_first) / (2.0 * M_PI / 3.0))) % 3) + 3) % 3;
-    per_petal[k] += std::polar(1.0, 3.0 * a.angle);
+    per_petal[k] += a.unit3;
     ++per_petal_count[k];
     per_petal_border[k] = per_petal_border[k] || a.border;
   }

@@ -21,14 +21,33 @@ int split(int begin, int end, int k, int n) {
 PyramidMethod::PyramidMethod(const AdapterGeometry& geometry, const PyramidOptions& options)
     : options_(options), fitter_(geometry, options.fit) {}
 
-void PyramidMethod::cellFeatures(const Eigen::Isometry3d& T_port_lidar, PyramidCell* cell) const {
+PyramidMethod::CellSums& PyramidMethod::CellSums::operator+=(const CellSums& other) {
+  s_r += other.s_r;
+  s_u += other.s_u;
+  s_v += other.s_v;
+  s_uu += other.s_uu;
+  s_uv += other.s_uv;
+  s_vv += other.s_vv;
+  s_ur += other.s_ur;
+  s_vr += other.s_vr;
+  s_p += other.s_p;
+  s_pp += other.s_pp;
+  count += other.count;
+  ring += other.ring;
+  behind += other.behind;
+  return *this;
+}
+
+void PyramidMethod::cellSums(const Eigen::Isometry3d& T_port_lidar, const PyramidCell& cell, CellSums* sums,
+                             std::vector<int>* ring_pixels) const {
   const AdapterGeometry& g = fitter_.geometry();
   double s_r = 0, s_u = 0, s_v = 0, s_uu = 0, s_uv = 0, s_vv = 0, s_ur = 0, s_vr = 0;
   Eigen::Vector3d s_p = Eigen::Vector3d::Zero();
   Eigen::Matrix3d s_pp = Eigen::Matrix3d::Zero();
   int count = 0, ring = 0, behind = 0;
-  for (int v = cell->v0; v < cell->v1; ++v) {
-    for (int u = cell->u0; u < cell->u1; ++u) {
+  ring_pixels->clear();
+  for (int v = cell.v0; v < cell.v1; ++v) {
+    for (int u = cell.u0; u < cell.u1; ++u) {
       const int i = v * frame_.width + u;
       if (!frame_.isValid(i)) continue;
       const double r = frame_.range_m[i];
@@ -43,37 +62,55 @@ void PyramidMethod::cellFeatures(const Eigen::Isometry3d& T_port_lidar, PyramidC
       s_ur += u * r;
       s_vr += v * r;
       s_p += p;
-      s_pp += p * p.transpose();
+      s_pp.noalias() += p * p.transpose();
       const Eigen::Vector3d q = T_port_lidar * p;
       const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
       if (std::abs(q.x()) < options_.ring_band_m &&
           radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
           radius < g.ring_outer_radius_m + options_.lateral_margin_m) {
         ++ring;
+        ring_pixels->push_back(i);
       } else if (q.x() < -options_.behind_m) {
         ++behind;
       }
     }
   }
-  cell->count = count;
-  if (count < options_.min_cell_pixels) return;
-  const double n = count;
-  cell->mean_range_m = s_r / n;
+  sums->s_r = s_r;
+  sums->s_u = s_u;
+  sums->s_v = s_v;
+  sums->s_uu = s_uu;
+  sums->s_uv = s_uv;
+  sums->s_vv = s_vv;
+  sums->s_ur = s_ur;
+  sums->s_vr = s_vr;
+  sums->s_p = s_p;
+  sums->s_pp = s_pp;
+  sums->count = count;
+  sums->ring = ring;
+  sums->behind = behind;
+}
+
+void PyramidMethod::cellFeatures(const CellSums& sums, PyramidCell* cell) const {
+  cell->count = sums.count;
+  if (sums.count < options_.min_cell_pixels) return;
+  const double n = sums.count;
+  cell->mean_range_m = sums.s_r / n;
   // Range slopes: least squares r = a + slope_u (u - mean u) + slope_v (v - mean v).
   Eigen::Matrix2d A;
-  A << s_uu - s_u * s_u / n, s_uv - s_u * s_v / n, s_uv - s_u * s_v / n, s_vv - s_v * s_v / n;
-  const Eigen::Vector2d b(s_ur - s_u * s_r / n, s_vr - s_v * s_r / n);
+  A << sums.s_uu - sums.s_u * sums.s_u / n, sums.s_uv - sums.s_u * sums.s_v / n,
+      sums.s_uv - sums.s_u * sums.s_v / n, sums.s_vv - sums.s_v * sums.s_v / n;
+  const Eigen::Vector2d b(sums.s_ur - sums.s_u * sums.s_r / n, sums.s_vr - sums.s_v * sums.s_r / n);
   const Eigen::Vector2d slope = A.ldlt().solve(b);
   cell->slope_u = slope(0);
   cell->slope_v = slope(1);
-  const Eigen::Vector3d mean = s_p / n;
-  const Eigen::Matrix3d cov = s_pp / n - mean * mean.transpose();
+  const Eigen::Vector3d mean = sums.s_p / n;
+  const Eigen::Matrix3d cov = sums.s_pp / n - mean * mean.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
   cell->normal = eig.eigenvectors().col(0);
   if (cell->normal.z() > 0.0) cell->normal = -cell->normal;
   cell->rms_m = std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
-  cell->ring_fraction = ring / n;
-  cell->behind_fraction = behind / n;
+  cell->ring_fraction = sums.ring / n;
+  cell->behind_fraction = sums.behind / n;
 }
 
 Eigen::Isometry3d PyramidMethod::alignRange(const Eigen::Isometry3d& T_lidar_port_predicted) const {
@@ -124,8 +161,18 @@ PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
   const double predicted_range = T_lidar_port_prior.translation().norm();
   const double cell_area = frame_.width * frame_.height / 9.0;
 
-  // Level 1.
+  // Level 1. One pass over the frame sums the fine cells, which tile the coarse ones: a coarse cell's sums
+  // are its fine cells' (level 2 then costs nothing per pixel, and the ring-band pixels are kept from the
+  // pass).
   fine_.clear();
+  const auto fineCell = [](const PyramidCell& coarse, int k) {
+    PyramidCell cell;
+    cell.u0 = split(coarse.u0, coarse.u1, k % 3, 3);
+    cell.u1 = split(coarse.u0, coarse.u1, k % 3 + 1, 3);
+    cell.v0 = split(coarse.v0, coarse.v1, k / 3, 3);
+    cell.v1 = split(coarse.v0, coarse.v1, k / 3 + 1, 3);
+    return cell;
+  };
   for (int k = 0; k < 9; ++k) {
     PyramidCell& cell = coarse_[k];
     cell = PyramidCell();
@@ -133,7 +180,12 @@ PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
     cell.u1 = split(0, frame_.width, k % 3 + 1, 3);
     cell.v0 = split(0, frame_.height, k / 3, 3);
     cell.v1 = split(0, frame_.height, k / 3 + 1, 3);
-    cellFeatures(T_port_lidar, &cell);
+    CellSums sums;
+    for (int f = 0; f < 9; ++f) {
+      cellSums(T_port_lidar, fineCell(cell, f), &fine_sums_[9 * k + f], &fine_ring_pixels_[9 * k + f]);
+      sums += fine_sums_[9 * k + f];
+    }
+    cellFeatures(sums, &cell);
     if (cell.count >= options_.min_fill * cell_area &&
         cell.ring_fraction >= options_.min_ring_fraction_coarse &&
         std::abs(cell.mean_range_m - predicted_range) <= options_.max_range_offset_m) {
@@ -143,15 +195,14 @@ PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
 
   // Level 2.
   std::vector<Eigen::Vector3d> candidate_normals;
-  for (const PyramidCell& coarse : coarse_) {
+  std::vector<int> fine_slots;  // fine_[m]'s index into fine_sums_ and fine_ring_pixels_
+  for (int c = 0; c < 9; ++c) {
+    const PyramidCell& coarse = coarse_[c];
     if (coarse.verdict != PyramidCell::Verdict::kPromising) continue;
     for (int k = 0; k < 9; ++k) {
-      PyramidCell cell;
-      cell.u0 = split(coarse.u0, coarse.u1, k % 3, 3);
-      cell.u1 = split(coarse.u0, coarse.u1, k % 3 + 1, 3);
-      cell.v0 = split(coarse.v0, coarse.v1, k / 3, 3);
-      cell.v1 = split(coarse.v0, coarse.v1, k / 3 + 1, 3);
-      cellFeatures(T_port_lidar, &cell);
+      PyramidCell cell = fineCell(coarse, k);
+      cellFeatures(fine_sums_[9 * c + k], &cell);
+      fine_slots.push_back(9 * c + k);
       if (cell.count < options_.min_cell_pixels) {
         fine_.push_back(cell);
         continue;
@@ -179,25 +230,14 @@ PoseResult PyramidMethod::estimate(const OrganizedCloud& cloud,
   }
   const double max_cos = std::cos(options_.max_normal_deviation_deg * M_PI / 180.0);
   ring_pixels_.clear();
-  const AdapterGeometry& g = fitter_.geometry();
-  for (PyramidCell& cell : fine_) {
+  for (std::size_t m = 0; m < fine_.size(); ++m) {
+    PyramidCell& cell = fine_[m];
     if (cell.verdict == PyramidCell::Verdict::kFace && cell.normal.dot(consensus) < max_cos) {
       cell.verdict = PyramidCell::Verdict::kRejected;
     }
     if (cell.verdict != PyramidCell::Verdict::kFace && cell.verdict != PyramidCell::Verdict::kEdge) continue;
-    for (int v = cell.v0; v < cell.v1; ++v) {
-      for (int u = cell.u0; u < cell.u1; ++u) {
-        const int i = v * frame_.width + u;
-        if (!frame_.isValid(i)) continue;
-        const Eigen::Vector3d q = T_port_lidar * frame_.points[i].cast<double>();
-        const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
-        if (std::abs(q.x()) < options_.ring_band_m &&
-            radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
-            radius < g.ring_outer_radius_m + options_.lateral_margin_m) {
-          ring_pixels_.push_back(i);
-        }
-      }
-    }
+    const std::vector<int>& pixels = fine_ring_pixels_[fine_slots[m]];
+    ring_pixels_.insert(ring_pixels_.end(), pixels.begin(), pixels.end());
   }
   // Too few passing cells (the ring only a few pixels wide, far out, or leaving the view): the back end
   // labels the ring from the prediction instead.

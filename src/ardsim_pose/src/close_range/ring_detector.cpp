@@ -16,15 +16,15 @@ struct ClusterMetrics {
 };
 
 // Scores one cluster against the ring's criteria (ring_detector.h); false as soon as one fails.
-bool scoreCluster(const PreparedFrame& frame, const std::vector<int>& all_members,
+bool scoreCluster(const PreparedFrame& frame, const int* all_members, std::size_t member_count,
                   const std::vector<int>& label, int cluster, const RingDetectorOptions& options,
                   ClusterMetrics* m) {
   // The metrics are statistics over the cluster: a spread sample of at most ~2000 of its pixels (in growth
   // order) is enough and keeps the cost per cluster bounded.
-  const std::size_t step = std::max<std::size_t>(1, all_members.size() / 2000);
+  const std::size_t step = std::max<std::size_t>(1, member_count / 2000);
   std::vector<int> members;
-  members.reserve(all_members.size() / step + 1);
-  for (std::size_t k = 0; k < all_members.size(); k += step) members.push_back(all_members[k]);
+  members.reserve(member_count / step + 1);
+  for (std::size_t k = 0; k < member_count; k += step) members.push_back(all_members[k]);
   // Plane of the cluster, twice: the second time without the members far from the first plane (a cluster can
   // leak onto a steep surface next to the ring, the passage's wall).
   Eigen::Vector3d mean = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();
@@ -187,22 +187,27 @@ void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, 
   // Clusters grow over every stride-th pixel in both directions (the ring is tens of pixels wide down to 7
   // m); the ring's pixels are filled in at full resolution at the end.
   const int stride = options.stride;
+  // -1: a return in no cluster yet, -2: no return (one test per neighbour instead of two).
   std::vector<int>& label = scratch->label;
-  label.assign(n, -1);
+  label.resize(n);
+  for (int i = 0; i < n; ++i) label[i] = frame.isValid(i) ? -1 : -2;
+  // The cluster's members in growth order, members[0, tail): sized once for the largest cluster, so adding
+  // one is a store.
   std::vector<int>& members = scratch->members;
+  members.resize(n);
   // Each member's image row, kept beside it: an integer division per pixel cost as much as the growing.
   std::vector<int>& rows = scratch->rows;
+  rows.resize(n);
   int next_label = 0;
   for (int v0 = 0; v0 < height; v0 += stride) {
     for (int u0 = 0; u0 < width; u0 += stride) {
       const int seed = v0 * width + u0;
-      if (label[seed] >= 0 || !frame.isValid(seed)) continue;
-      members.clear();
-      rows.clear();
-      members.push_back(seed);
-      rows.push_back(v0);
+      if (label[seed] != -1) continue;
+      std::size_t tail = 0;
+      members[tail] = seed;
+      rows[tail++] = v0;
       label[seed] = next_label;
-      for (std::size_t head = 0; head < members.size(); ++head) {
+      for (std::size_t head = 0; head < tail; ++head) {
         const int i = members[head];
         const int v = rows[head], u = i - v * width;
         const float r = frame.range_m[i];
@@ -214,22 +219,23 @@ void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, 
         const int neighbour_rows[4] = {v, v, v - stride, v + stride};
         for (int k = 0; k < 4; ++k) {
           const int j = neighbours[k];
-          if (j < 0 || label[j] >= 0 || !frame.isValid(j)) continue;
+          if (j < 0 || label[j] != -1) continue;
           if (std::abs(frame.range_m[j] - r) > step) continue;
           label[j] = next_label;
-          members.push_back(j);
-          rows.push_back(neighbour_rows[k]);
+          members[tail] = j;
+          rows[tail++] = neighbour_rows[k];
         }
       }
       ++next_label;
-      if (static_cast<int>(members.size()) * stride * stride < options.min_cluster_pixels) continue;
+      if (static_cast<int>(tail) * stride * stride < options.min_cluster_pixels) continue;
       ++detection->clusters;
       ClusterMetrics metrics;
-      if (!scoreCluster(frame, members, label, next_label - 1, options, &metrics)) continue;
-      if (detection->found && members.size() <= detection->pixels.size()) continue;
+      if (!scoreCluster(frame, members.data(), tail, label, next_label - 1, options, &metrics)) continue;
+      if (detection->found && tail <= detection->pixels.size()) continue;
       detection->found = true;
       detection->pixels.clear();
-      for (int i : members) {
+      for (std::size_t m = 0; m < tail; ++m) {
+        const int i = members[m];
         // The stride x stride block of each member, where on the cluster's plane.
         for (int dv = 0; dv < stride && i / width + dv < height; ++dv) {
           for (int du = 0; du < stride && i % width + du < width; ++du) {

@@ -147,20 +147,23 @@ class AdapterFitter {
   bool fitCross(const std::vector<Eigen::Vector2d>& points, Eigen::Vector2d* centre, double* angle) const;
   // A start for fitCross that does not need the centre: where the points pile up across each arm.
   Eigen::Vector2d crossStart(const std::vector<Eigen::Vector2d>& points, double angle) const;
+  // stride: every stride-th pixel in u and v is labelled and scanned for edges (the first round's guess
+  // only).
   bool fitRound(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                const Eigen::Isometry3d& T_lidar_port_guess, double band, RoundResult* out,
+                const Eigen::Isometry3d& T_lidar_port_guess, double band, int stride, RoundResult* out,
                 std::string* reason);
   bool onBorder(const PreparedFrame& frame, int pixel) const;
   // Joint fit of the unit normal n and offset d with n.p = d + face_x for every point (robust, a few
-  // Gauss-Newton steps); returns false with too few inliers.
-  bool fitPlanes(std::vector<PlanePoint>& points, Eigen::Vector3d* normal, double* offset, double* rms,
-                 int* used);
+  // Gauss-Newton steps); returns false with too few inliers (each point standing for stride x stride pixels).
+  bool fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen::Vector3d* normal, double* offset,
+                 double* rms, int* used);
   void labelPlanePoints(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                        const Eigen::Isometry3d& T_lidar_port, double band);
+                        const Eigen::Isometry3d& T_lidar_port, double band, int stride);
 
   AdapterGeometry geometry_;
   AdapterFitOptions options_;
   std::vector<PlanePoint> plane_points_;
+  std::vector<int> cross_face_points_;  // indices into plane_points_ of the cross face's points
   std::vector<std::uint8_t> is_ring_;
   std::vector<double> along_;  // n.p of each pixel for the ring-edge scan
   std::vector<Eigen::Vector2d> inner_edge_, outer_edge_, cross_points_;

@@ -79,7 +79,18 @@ class PyramidMethod : public PoseMethod {
   const AdapterFitReport& lastReport() const { return report_; }
 
  private:
-  void cellFeatures(const Eigen::Isometry3d& T_port_lidar, PyramidCell* cell) const;
+  // Sums over one cell's valid pixels; a coarse cell's are the sums of its nine fine cells'.
+  struct CellSums {
+    double s_r = 0, s_u = 0, s_v = 0, s_uu = 0, s_uv = 0, s_vv = 0, s_ur = 0, s_vr = 0;
+    Eigen::Vector3d s_p = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d s_pp = Eigen::Matrix3d::Zero();
+    int count = 0, ring = 0, behind = 0;
+    CellSums& operator+=(const CellSums& other);
+  };
+  // The sums of the pixels in the cell's bounds; its ring-band pixels (row by row) into ring_pixels.
+  void cellSums(const Eigen::Isometry3d& T_port_lidar, const PyramidCell& cell, CellSums* sums,
+                std::vector<int>* ring_pixels) const;
+  void cellFeatures(const CellSums& sums, PyramidCell* cell) const;
   Eigen::Isometry3d alignRange(const Eigen::Isometry3d& T_lidar_port_predicted) const;
 
   PyramidOptions options_;
@@ -87,6 +98,10 @@ class PyramidMethod : public PoseMethod {
   PreparedFrame frame_;
   std::array<PyramidCell, 9> coarse_;
   std::vector<PyramidCell> fine_;
+  // The 81 fine cells' sums and ring-band pixels from the one pass over the frame (coarse cell k's fine cells
+  // at 9 k ... 9 k + 8).
+  std::array<CellSums, 81> fine_sums_;
+  std::array<std::vector<int>, 81> fine_ring_pixels_;
   std::vector<int> ring_pixels_;
   AdapterFitReport report_;
 };
