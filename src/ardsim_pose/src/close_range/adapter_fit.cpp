@@ -127,12 +127,12 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
     for (int u = 0; u < frame.width; u += stride) {
       const int i = v * frame.width + u;
       if (!frame.isValid(i)) continue;
-      const Eigen::Vector3d p = frame.points[i].cast<double>();
       // The front end's ring pixels (a good part of the frame) need no transform.
       if (is_ring_[i]) {
-        plane_points_.push_back({p, face_x[0], 0, i});
+        plane_points_.push_back({frame.points[i], 0, face_x[0]});
         continue;
       }
+      const Eigen::Vector3d p = frame.points[i].cast<double>();
       const Eigen::Vector3d q = R * p + t;
       const double r2 = q.y() * q.y() + q.z() * q.z();
       const bool off_cross = std::abs(q.y()) > 0.04 && std::abs(q.z()) > 0.04;
@@ -150,7 +150,7 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
         face = 4;
       }
       if (face == 4) cross_face_points_.push_back(static_cast<int>(plane_points_.size()));
-      if (face >= 0) plane_points_.push_back({p, face_x[face], face, i});
+      if (face >= 0) plane_points_.push_back({frame.points[i], face, face_x[face]});
     }
   }
 }
@@ -193,7 +193,8 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen
     };
     for (std::size_t k = 0; k < points.size(); k += step) {
       const PlanePoint& pp = points[k];
-      const double residual = n.dot(pp.p) - d - pp.face_x;
+      const Eigen::Vector3d p = pp.p.cast<double>();
+      const double residual = n.dot(p) - d - pp.face_x;
       if (std::abs(residual) > reject) continue;
       if (pp.face != current) {
         store();
@@ -211,7 +212,6 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen
         u4 = f.upper[4];
         u5 = f.upper[5];
       }
-      const Eigen::Vector3d& p = pp.p;
       count += 1.0;
       s0 += p.x();
       s1 += p.y();
@@ -558,7 +558,8 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   cross_points_.clear();
   for (int k : cross_face_points_) {
     const PlanePoint& pp = plane_points_[k];
-    if (std::abs(n.dot(pp.p) - d - pp.face_x) <= on_plane) cross_points_.push_back(inPlane(pp.p));
+    const Eigen::Vector3d p = pp.p.cast<double>();
+    if (std::abs(n.dot(p) - d - pp.face_x) <= on_plane) cross_points_.push_back(inPlane(p));
   }
   r.report.cross_points = static_cast<int>(cross_points_.size());
   Eigen::Vector2d cross_centre = r.centre_guess;

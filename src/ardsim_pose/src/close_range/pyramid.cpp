@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 #include <Eigen/Eigenvalues>
 
@@ -41,7 +42,10 @@ PyramidMethod::CellSums& PyramidMethod::CellSums::operator+=(const CellSums& oth
 void PyramidMethod::cellSums(const Eigen::Isometry3d& T_port_lidar, const PyramidCell& cell, CellSums* sums,
                              std::vector<int>* ring_pixels) const {
   const AdapterGeometry& g = fitter_.geometry();
-  double s_r = 0, s_u = 0, s_v = 0, s_uu = 0, s_uv = 0, s_vv = 0, s_ur = 0, s_vr = 0;
+  double s_r = 0, s_ur = 0, s_vr = 0;
+  // The pixel coordinates' sums are integers, exact in double too: kept in integer registers (fewer
+  // floating-point accumulators to spill, the same sums).
+  std::int64_t s_u = 0, s_v = 0, s_uu = 0, s_uv = 0, s_vv = 0;
   Eigen::Vector3d s_p = Eigen::Vector3d::Zero();
   Eigen::Matrix3d s_pp = Eigen::Matrix3d::Zero();
   int count = 0, ring = 0, behind = 0;
@@ -56,18 +60,23 @@ void PyramidMethod::cellSums(const Eigen::Isometry3d& T_port_lidar, const Pyrami
       s_r += r;
       s_u += u;
       s_v += v;
-      s_uu += double(u) * u;
-      s_uv += double(u) * v;
-      s_vv += double(v) * v;
+      s_uu += u * u;
+      s_uv += u * v;
+      s_vv += v * v;
       s_ur += u * r;
       s_vr += v * r;
       s_p += p;
       s_pp.noalias() += p * p.transpose();
       const Eigen::Vector3d q = T_port_lidar * p;
-      const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
-      if (std::abs(q.x()) < options_.ring_band_m &&
-          radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
-          radius < g.ring_outer_radius_m + options_.lateral_margin_m) {
+      // The square root only for the pixels in the ring's depth band: computed for every pixel, its latency
+      // was a third of the pass.
+      bool in_ring = false;
+      if (std::abs(q.x()) < options_.ring_band_m) {
+        const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
+        in_ring = radius > g.ring_inner_radius_m - options_.lateral_margin_m &&
+                  radius < g.ring_outer_radius_m + options_.lateral_margin_m;
+      }
+      if (in_ring) {
         ++ring;
         ring_pixels->push_back(i);
       } else if (q.x() < -options_.behind_m) {
@@ -76,11 +85,11 @@ void PyramidMethod::cellSums(const Eigen::Isometry3d& T_port_lidar, const Pyrami
     }
   }
   sums->s_r = s_r;
-  sums->s_u = s_u;
-  sums->s_v = s_v;
-  sums->s_uu = s_uu;
-  sums->s_uv = s_uv;
-  sums->s_vv = s_vv;
+  sums->s_u = static_cast<double>(s_u);
+  sums->s_v = static_cast<double>(s_v);
+  sums->s_uu = static_cast<double>(s_uu);
+  sums->s_uv = static_cast<double>(s_uv);
+  sums->s_vv = static_cast<double>(s_vv);
   sums->s_ur = s_ur;
   sums->s_vr = s_vr;
   sums->s_p = s_p;

@@ -201,8 +201,15 @@ void detectRing(const PreparedFrame& frame, const RingDetectorOptions& options, 
   int next_label = 0;
   for (int v0 = 0; v0 < height; v0 += stride) {
     for (int u0 = 0; u0 < width; u0 += stride) {
+      // The next seed by a scan in locals of its own (u0, live across the growing, sat on the stack and each
+      // step of the scan waited on its store): most pixels are in a cluster by the time the scan reaches
+      // them.
+      const int* row_labels = label.data() + v0 * width;
+      int u = u0;
+      while (u < width && row_labels[u] != -1) u += stride;
+      if (u >= width) break;
+      u0 = u;
       const int seed = v0 * width + u0;
-      if (label[seed] != -1) continue;
       std::size_t tail = 0;
       members[tail] = seed;
       rows[tail++] = v0;

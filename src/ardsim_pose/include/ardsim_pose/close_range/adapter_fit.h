@@ -120,11 +120,12 @@ class AdapterFitter {
  private:
   // The adapter's faces parallel to the docking plane: ring, tunnel, hatch, target plate, cross.
   static constexpr int kFaces = 5;
+  // 24 bytes (the frame's float point, cast where used: the same values): each round writes one per pixel on
+  // a face and the plane fit reads them back, so their size is memory traffic.
   struct PlanePoint {
-    Eigen::Vector3d p;
-    double face_x;  // the face's x in the port frame
+    Eigen::Vector3f p;
     int face;       // 0..kFaces-1
-    int pixel;
+    double face_x;  // the face's x in the port frame
   };
   // One pass of labels, plane fit, ring edges, circle and cross from a guess of the port's pose.
   struct RoundResult {
