@@ -1,5 +1,6 @@
 #include "lidar_driver.h"
 #include <ardsim_msgs/log_throttle.h>
+#include <ardsim_msgs/param_read.h>
 
 #include <cmath>
 #include <limits>
@@ -17,12 +18,9 @@ namespace {
 
 constexpr std::uint32_t kRecorderQueue = 50;  // frames queued per subscriber connection
 
-// A parameter that is set but has the wrong type is an error, not a silent default.
 template <typename T>
 void read(const ros::NodeHandle& nh, const std::string& name, T* value) {
-  if (!nh.hasParam(name)) return;
-  if (!nh.getParam(name, *value))
-    throw std::invalid_argument("parameter " + name + " has the wrong type (see config/lidar.yaml)");
+  ardsim_msgs::readParam(nh, name, value, "config/lidar.yaml");
 }
 
 void readFloat(const ros::NodeHandle& nh, const std::string& name, double* value) {

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <ardsim_msgs/log_throttle.h>
+#include <ardsim_msgs/param_read.h>
 
 #include "ardsim_dynamics/scenario.h"
 #include "conversions.h"
@@ -13,12 +14,9 @@ namespace ardsim_pose {
 
 namespace {
 
-// A parameter that is set but has the wrong type is an error, not a silent default.
 template <typename T>
 void read(const ros::NodeHandle& nh, const std::string& name, T* value) {
-  if (!nh.hasParam(name)) return;
-  if (!nh.getParam(name, *value))
-    throw std::invalid_argument("parameter " + name + " has the wrong type (see config/pose.yaml)");
+  ardsim_msgs::readParam(nh, name, value, "config/pose.yaml");
 }
 
 void readVector(const ros::NodeHandle& nh, const std::string& name, Eigen::Vector3d* value) {
