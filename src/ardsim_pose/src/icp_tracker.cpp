@@ -151,19 +151,20 @@ void IcpTracker::alignRange(Eigen::Isometry3d* T) {
   }
 }
 
-bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H,
-                                   const Eigen::Vector3d& centre) const {
-  // Rotations scaled by the lever arm so that units compare; the information about the boresight rotation
-  // once the other five are free, against the largest eigenvalue.
+Eigen::Matrix<double, 6, 6> IcpTracker::leverScaled(const Eigen::Matrix<double, 6, 6>& H,
+                                                    const Eigen::Vector3d& centre) const {
+  // Rotations scaled by the correspondences' lever arm about centre, so that units compare.
   double lever_sq = 0.0;
   for (const Correspondence& c : correspondences_) lever_sq += (c.model - centre).squaredNorm();
   const double lever = std::sqrt(lever_sq / std::max<std::size_t>(1, correspondences_.size()));
   Eigen::Matrix<double, 6, 1> scale;
   scale << 1, 1, 1, 1.0 / lever, 1.0 / lever, 1.0 / lever;
-  const Eigen::Matrix<double, 6, 6> H_scaled = scale.asDiagonal() * H * scale.asDiagonal();
-  const double largest =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
-          .eigenvalues()(5);
+  return scale.asDiagonal() * H * scale.asDiagonal();
+}
+
+bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest) const {
+  // The information about the boresight rotation once the other five are free, against the largest
+  // eigenvalue.
   const Eigen::Matrix<double, 6, 1> column = H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 1>::Unit(5));
   return largest > 0.0 && column(5) > 0.0 && 1.0 / column(5) / largest > options_.degraded_condition;
 }
@@ -176,38 +177,9 @@ void IcpTracker::predictVisibility(const Eigen::Isometry3d& T) {
   visibility_valid_ = true;
 }
 
-double IcpTracker::silhouetteInlierFraction(double limit_m) const {
-  const std::vector<float>& model_depth = visibility_.modelDepth();
-  const int w = visibility_.gridWidth(), h = visibility_.gridHeight(), cell = visibility_.cellPx();
-  auto on_silhouette = [&](const Eigen::Vector3d& p) {
-    if (!(p.z() > 0.0)) return false;
-    const double u = intrinsics_.fx * p.x() / p.z() + intrinsics_.cx + 0.5;
-    const double v = intrinsics_.fy * p.y() / p.z() + intrinsics_.cy + 0.5;
-    if (!(u >= 0.0 && v >= 0.0 && u < intrinsics_.width && v < intrinsics_.height)) return false;
-    const int x = static_cast<int>(u) / cell, y = static_cast<int>(v) / cell;
-    for (int j = std::max(0, y - 1); j <= std::min(h - 1, y + 1); ++j) {
-      for (int i = std::max(0, x - 1); i <= std::min(w - 1, x + 1); ++i) {
-        if (std::isfinite(model_depth[j * w + i])) return true;
-      }
-    }
-    return false;
-  };
-  int on = 0, inliers = 0;
-  for (const Eigen::Vector3f& s : scan_) on += on_silhouette(s.cast<double>()) ? 1 : 0;
-  for (const Correspondence& c : correspondences_) {
-    if (std::abs(c.residual) < limit_m && on_silhouette(c.scan)) ++inliers;
-  }
-  return on > 0 ? static_cast<double>(inliers) / on : 0.0;
-}
-
-void IcpTracker::gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isometry3d& T, double margin_px) {
-  gated_ = valid_;
-  if (!(margin_px > 0.0)) return;
-  predictVisibility(T);
+void IcpTracker::markSilhouette(int r) {
   const std::vector<float>& model_depth = visibility_.modelDepth();
   const int w = visibility_.gridWidth(), h = visibility_.gridHeight();
-  const int r = static_cast<int>(std::ceil(margin_px / visibility_.cellPx()));
-  if (r >= std::max(w, h)) return;
   // Square dilation of the silhouette's cells by r, separably (rows, then columns).
   silhouette_rows_.assign(model_depth.size(), 0);
   silhouette_.assign(model_depth.size(), 0);
@@ -223,6 +195,32 @@ void IcpTracker::gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isom
       for (int k = std::max(0, y - r); k <= std::min(h - 1, y + r); ++k) silhouette_[k * w + x] = 1;
     }
   }
+}
+
+double IcpTracker::silhouetteInlierFraction(double limit_m) {
+  markSilhouette(1);
+  auto on_silhouette = [&](const Eigen::Vector3d& p) {
+    if (!(p.z() > 0.0)) return false;
+    const double u = intrinsics_.fx * p.x() / p.z() + intrinsics_.cx + 0.5;
+    const double v = intrinsics_.fy * p.y() / p.z() + intrinsics_.cy + 0.5;
+    if (!(u >= 0.0 && v >= 0.0 && u < intrinsics_.width && v < intrinsics_.height)) return false;
+    return silhouette_[visibility_.cellOfPixel(static_cast<int>(u), static_cast<int>(v))] != 0;
+  };
+  int on = 0, inliers = 0;
+  for (const Eigen::Vector3f& s : scan_) on += on_silhouette(s.cast<double>()) ? 1 : 0;
+  for (const Correspondence& c : correspondences_) {
+    if (std::abs(c.residual) < limit_m && on_silhouette(c.scan)) ++inliers;
+  }
+  return on > 0 ? static_cast<double>(inliers) / on : 0.0;
+}
+
+void IcpTracker::gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isometry3d& T, double margin_px) {
+  gated_ = valid_;
+  if (!(margin_px > 0.0)) return;
+  predictVisibility(T);
+  const int r = static_cast<int>(std::ceil(margin_px / visibility_.cellPx()));
+  if (r >= std::max(visibility_.gridWidth(), visibility_.gridHeight())) return;
+  markSilhouette(r);
   gated_.clear();
   for (int i : valid_) {
     if (silhouette_[visibility_.cellOfPixel(i % cloud.width, i / cloud.width)]) gated_.push_back(i);
@@ -312,7 +310,11 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     // A rotation about the boresight that the scan does not constrain (the roll of a cylinder such as Hubble
     // about its axis) is held at its prediction: left free it wanders on noise and never converges.
     Eigen::Matrix<double, 6, 1> delta = Eigen::Matrix<double, 6, 1>::Zero();
-    if (boresightObserved(a.H, a.centre)) {
+    const Eigen::Matrix<double, 6, 6> H_scaled = leverScaled(a.H, a.centre);
+    const double largest =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
+            .eigenvalues()(5);
+    if (boresightObserved(H_scaled, largest)) {
       delta = a.H.ldlt().solve(g);
     } else {
       delta.head<5>() = a.H.topLeftCorner<5, 5>().ldlt().solve(g.head<5>());
@@ -520,17 +522,12 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   const Eigen::Matrix<double, 6, 6> H_inverse = H.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
   result.covariance = A * (variance * H_inverse) * A.transpose();
 
-  // Condition of the normal equations with the rotations scaled by the lever arm, so that units compare.
-  double lever_sq = 0.0;
-  for (const Correspondence& c : correspondences_) lever_sq += (c.model - centre).squaredNorm();
-  const double lever = std::sqrt(lever_sq / correspondences_.size());
-  Eigen::Matrix<double, 6, 1> scale;
-  scale << 1, 1, 1, 1.0 / lever, 1.0 / lever, 1.0 / lever;
-  const Eigen::Matrix<double, 6, 6> H_scaled = scale.asDiagonal() * H * scale.asDiagonal();
+  // Condition of the lever-scaled normal equations.
+  const Eigen::Matrix<double, 6, 6> H_scaled = leverScaled(H, centre);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(H_scaled);
   const double largest = eigen.eigenvalues()(5);
   const double condition = largest > 0.0 ? eigen.eigenvalues()(0) / largest : 0.0;
-  result.boresight_rotation_observed = boresightObserved(H, centre);
+  result.boresight_rotation_observed = boresightObserved(H_scaled, largest);
   // With the boresight rotation unobserved (held at its prediction, flagged), the pose is still good when
   // the other five are well constrained: judge the condition of those five.
   double condition_of_the_rest = condition;

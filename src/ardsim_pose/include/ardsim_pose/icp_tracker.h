@@ -116,13 +116,18 @@ class IcpTracker : public PoseMethod {
   void alignRange(Eigen::Isometry3d* T);
   // visibility_.predict at T into visible_, unless the last prediction was at exactly T.
   void predictVisibility(const Eigen::Isometry3d& T);
-  // Whether the normal equations H (about centre, from correspondences_) constrain the rotation about the
-  // boresight: its information with the other five free, over the largest eigenvalue (lever-scaled), above
+  // H with its rotation rows and columns scaled by the correspondences' lever arm about centre.
+  Eigen::Matrix<double, 6, 6> leverScaled(const Eigen::Matrix<double, 6, 6>& H,
+                                          const Eigen::Vector3d& centre) const;
+  // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the
+  // boresight: its information with the other five free, over the largest eigenvalue, above
   // degraded_condition.
-  bool boresightObserved(const Eigen::Matrix<double, 6, 6>& H, const Eigen::Vector3d& centre) const;
+  bool boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest) const;
+  // silhouette_: the cells with a surface in the last visibility prediction, dilated by r cells.
+  void markSilhouette(int r);
   // Of the scan points on the model's silhouette at the pose of the last visibility prediction (a cell with
   // a predicted surface or next to one), the fraction within limit_m of the model in the last iteration.
-  double silhouetteInlierFraction(double limit_m) const;
+  double silhouetteInlierFraction(double limit_m);
   // Keeps the valid_ pixels within margin_px of the model's silhouette at T (unless too few would remain).
   void gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isometry3d& T, double margin_px);
 
@@ -142,7 +147,7 @@ class IcpTracker : public PoseMethod {
   std::vector<int> valid_;
   std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
-  std::vector<std::uint8_t> silhouette_;       // cells within the margin of the silhouette
+  std::vector<std::uint8_t> silhouette_;       // see markSilhouette
   std::vector<float> scan_depth_;
   struct Correspondence {
     Eigen::Vector3d scan;    // lidar frame
