@@ -142,12 +142,14 @@ void BM_IcpTrack_Ardsim(benchmark::State& state) {
   prime();
   ErrorCounters errors;
   int lost = 0;
+  double iterations = 0.0;
   std::size_t k = 0;
   for (auto _ : state) {
     const Frame& f = frames[k++ % frames.size()];
     const PoseResult result = tracker.estimate(f.cloud, f.guess);
     benchmark::DoNotOptimize(result);
     errors.add(result.T_lidar_target, f);
+    iterations += result.iterations;
     if (tracker.acquiring()) {  // LOST: back to tracking, untimed
       ++lost;
       state.PauseTiming();
@@ -157,6 +159,7 @@ void BM_IcpTrack_Ardsim(benchmark::State& state) {
   }
   errors.report(state, frames);
   state.counters["lost"] = lost;
+  state.counters["iterations"] = iterations / std::max<double>(1.0, static_cast<double>(k));
 }
 
 void BM_IcpTrack_PclIcp(benchmark::State& state) {

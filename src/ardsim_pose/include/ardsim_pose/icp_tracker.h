@@ -114,8 +114,11 @@ class IcpTracker : public PoseMethod {
   bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
   double coverage() const;
   void alignRange(Eigen::Isometry3d* T);
-  // visibility_.predict at T into visible_, unless the last prediction was at exactly T.
-  void predictVisibility(const Eigen::Isometry3d& T);
+  // visibility_.predict at T into visible_, unless the last prediction was at exactly T or (tolerance_px
+  // > 0) at a pose that puts every scan point within tolerance_px of where T puts it.
+  void predictVisibility(const Eigen::Isometry3d& T, double tolerance_px = 0.0);
+  // An upper bound on how far, in pixels, a scan point moves in the image between poses a and b.
+  double imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) const;
   // H with its rotation rows and columns scaled by the correspondences' lever arm about centre.
   Eigen::Matrix<double, 6, 6> leverScaled(const Eigen::Matrix<double, 6, 6>& H,
                                           const Eigen::Vector3d& centre) const;
@@ -149,6 +152,7 @@ class IcpTracker : public PoseMethod {
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
   std::vector<std::uint8_t> silhouette_;       // see markSilhouette
   std::vector<float> scan_depth_;
+  double scan_near_m_ = 1.0;  // depth of the nearest return of the frame
   struct Correspondence {
     Eigen::Vector3d scan;    // lidar frame
     Eigen::Vector3d model;   // lidar frame, at the current pose
