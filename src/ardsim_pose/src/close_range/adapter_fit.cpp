@@ -101,7 +101,8 @@ AdapterFitter::AdapterFitter(const AdapterGeometry& geometry, const AdapterFitOp
     : geometry_(geometry), options_(options) {}
 
 void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                                     const Eigen::Isometry3d& T_lidar_port, double band, int stride) {
+                                     const Eigen::Isometry3d& T_lidar_port, double band,
+                                     const Sampling& sampling) {
   const AdapterGeometry& g = geometry_;
   const double face_x[kFaces] = {0.0, g.tunnel_face_x_m, g.hatch_face_x_m, g.plate_face_x_m,
                                  g.cross_face_x_m};
@@ -123,8 +124,8 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
   is_ring_.assign(n, 0);
   for (int i : ring_face_pixels) is_ring_[i] = 1;
   const bool ring_from_model = ring_face_pixels.empty();
-  for (int v = 0; v < frame.height; v += stride) {
-    for (int u = 0; u < frame.width; u += stride) {
+  for (int v = 0; v < frame.height; v += sampling.row_step) {
+    for (int u = sampling.firstColumn(v); u < frame.width; u += sampling.col_step) {
       const int i = v * frame.width + u;
       if (!frame.isValid(i)) continue;
       // The front end's ring pixels (a good part of the frame) need no transform.
@@ -155,7 +156,7 @@ void AdapterFitter::labelPlanePoints(const PreparedFrame& frame, const std::vect
   }
 }
 
-bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen::Vector3d* normal,
+bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int pixels_per_point, Eigen::Vector3d* normal,
                               double* offset, double* rms, int* used) {
   // Each face's points enter the least squares only through their sums (count, sum of p, sum of p p^T), so
   // the Gauss-Newton steps cost nothing per point; the points are visited once per rejection scale: wide
@@ -230,7 +231,7 @@ bool AdapterFitter::fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen
       const std::array<double, 6>& u = f.upper;
       f.scatter << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
     }
-    if (inliers * static_cast<int>(step) * stride * stride < options_.min_plane_points) return false;
+    if (inliers * static_cast<int>(step) * pixels_per_point < options_.min_plane_points) return false;
     *rms = std::sqrt(sum_sq / inliers);
     *used = inliers;
     for (int step = 0; step < 3; ++step) {
@@ -365,17 +366,18 @@ bool AdapterFitter::fitCross(const std::vector<Eigen::Vector2d>& points, Eigen::
 }
 
 bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                             const Eigen::Isometry3d& T_lidar_port_guess, double band, int stride,
-                             RoundResult* out, std::string* reason) {
+                             const Eigen::Isometry3d& T_lidar_port_guess, double band,
+                             const Sampling& sampling, RoundResult* out, std::string* reason) {
   const AdapterGeometry& g = geometry_;
   RoundResult& r = *out;
   r = RoundResult();
 
   // 1. The adapter's faces and the joint plane fit.
-  labelPlanePoints(frame, ring_face_pixels, T_lidar_port_guess, band, stride);
+  labelPlanePoints(frame, ring_face_pixels, T_lidar_port_guess, band, sampling);
   r.n = T_lidar_port_guess.linear().col(0);
   r.d = r.n.dot(T_lidar_port_guess.translation());
-  if (!fitPlanes(plane_points_, stride, &r.n, &r.d, &r.report.plane_rms_m, &r.report.plane_points)) {
+  if (!fitPlanes(plane_points_, sampling.pixelsPerSample(), &r.n, &r.d, &r.report.plane_rms_m,
+                 &r.report.plane_points)) {
     *reason = "adapter faces not found (" + std::to_string(plane_points_.size()) + " points)";
     return false;
   }
@@ -408,10 +410,11 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   outer_edge_.clear();
   const int width = frame.width, height = frame.height;
   // n.p of every pixel scanned and of its four neighbours, once: each is read again as a neighbour of four.
-  // The edge points keep full resolution at any stride: a scanned pixel is paired with its adjacent pixels.
+  // The edge points keep full resolution at any sampling: a scanned pixel is paired with its adjacent
+  // pixels (in a checkerboard, or with every row scanned, that is every pixel).
   along_.resize(frame.points.size());
   for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; u += v % stride == 0 ? 1 : stride) {
+    for (int u = 0; u < width; u += v % sampling.row_step == 0 ? 1 : sampling.col_step) {
       along_[v * width + u] = n.dot(frame.points[v * width + u].cast<double>());
     }
   }
@@ -425,8 +428,8 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
     if (frame.isValid(j)) return d - along_[j] >= on_plane;
     return uk >= 0 && uk < width && vk >= 0 && vk < height && frame.isValid(vk * width + uk);
   };
-  for (int v = 0; v < height; v += stride) {
-    for (int u = 0; u < width; u += stride) {
+  for (int v = 0; v < height; v += sampling.row_step) {
+    for (int u = sampling.firstColumn(v); u < width; u += sampling.col_step) {
       const int i = v * width + u;
       if (!frame.isValid(i)) continue;
       if (std::abs(along_[i] - d) > on_plane) continue;
@@ -626,10 +629,12 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   for (int round = 0; round < 2; ++round) {
     // The first round only brings the guess near: every second pixel in u and v, a quarter of the cost (its
     // minimum edge and cross counts are not scaled down: a circle or cross it cannot back well enough leaves
-    // the plane-only second chance).
+    // the plane-only second chance). The second: a checkerboard (options_.fine_checkerboard) or every pixel.
+    const Sampling sampling =
+        round == 0 ? Sampling{2, 2, 0} : (options_.fine_checkerboard ? Sampling{1, 2, 1} : Sampling{});
     const bool ok = fitRound(frame, ring_face_pixels, T_guess,
-                             round == 0 ? options_.plane_band_m : 0.6 * options_.plane_band_m,
-                             round == 0 ? 2 : 1, &r, &result.reason);
+                             round == 0 ? options_.plane_band_m : 0.6 * options_.plane_band_m, sampling, &r,
+                             &result.reason);
     if (!ok && (round == 1 || r.report.plane_points == 0)) return finish(result);
     T_guess.linear() = portRotation(r.n, seed_boresight);
     T_guess.translation() = ok ? r.centre : r.origin;

@@ -153,7 +153,9 @@ namespace {
 void expectLostOrRight(PoseMethod& method, const OrganizedCloud& cloud, const Eigen::Isometry3d& prediction,
                        const Eigen::Isometry3d& truth, bool expect_lost) {
   const PoseResult result = method.estimate(cloud, prediction);
-  if (expect_lost) EXPECT_EQ(result.status, EstimateStatus::kLost) << result.reason;
+  if (expect_lost) {
+    EXPECT_EQ(result.status, EstimateStatus::kLost) << result.reason;
+  }
   if (result.status == EstimateStatus::kLost) return;
   const testing::PortError e = testing::portError(result.T_lidar_target, truth);
   EXPECT_LT(e.lateral(), 0.02);

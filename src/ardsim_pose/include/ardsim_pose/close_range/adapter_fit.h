@@ -65,6 +65,9 @@ struct AdapterFitOptions {
   double min_resultant = 0.6;       // circular concentration of the petals' angles to count as observed
   double max_step_from_prediction_m = 0.5;  // a larger jump from the prediction is not trusted: LOST
   double max_tilt_from_prediction_deg = 10.0;
+  // The final round labels the faces and scans for ring edges on every second pixel in a checkerboard (half
+  // the cost; tilt noise up by ~sqrt 2, far inside the goals); false: on every pixel.
+  bool fine_checkerboard = true;
 };
 
 // A frame made ready for the fits: points corrected for detector walk, ranges, validity.
@@ -148,18 +151,23 @@ class AdapterFitter {
   bool fitCross(const std::vector<Eigen::Vector2d>& points, Eigen::Vector2d* centre, double* angle) const;
   // A start for fitCross that does not need the centre: where the points pile up across each arm.
   Eigen::Vector2d crossStart(const std::vector<Eigen::Vector2d>& points, double angle) const;
-  // stride: every stride-th pixel in u and v is labelled and scanned for edges (the first round's guess
-  // only).
+  // The pixels a round labels and scans for edges: every row_step-th row, in it every col_step-th pixel from
+  // column (v / row_step * shift) % col_step (row_step 1, col_step 2, shift 1: a checkerboard).
+  struct Sampling {
+    int row_step = 1, col_step = 1, shift = 0;
+    int firstColumn(int v) const { return (v / row_step * shift) % col_step; }
+    int pixelsPerSample() const { return row_step * col_step; }
+  };
   bool fitRound(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                const Eigen::Isometry3d& T_lidar_port_guess, double band, int stride, RoundResult* out,
-                std::string* reason);
+                const Eigen::Isometry3d& T_lidar_port_guess, double band, const Sampling& sampling,
+                RoundResult* out, std::string* reason);
   bool onBorder(const PreparedFrame& frame, int pixel) const;
   // Joint fit of the unit normal n and offset d with n.p = d + face_x for every point (robust, a few
-  // Gauss-Newton steps); returns false with too few inliers (each point standing for stride x stride pixels).
-  bool fitPlanes(std::vector<PlanePoint>& points, int stride, Eigen::Vector3d* normal, double* offset,
-                 double* rms, int* used);
+  // Gauss-Newton steps); returns false with too few inliers (each point standing for pixels_per_point).
+  bool fitPlanes(std::vector<PlanePoint>& points, int pixels_per_point, Eigen::Vector3d* normal,
+                 double* offset, double* rms, int* used);
   void labelPlanePoints(const PreparedFrame& frame, const std::vector<int>& ring_face_pixels,
-                        const Eigen::Isometry3d& T_lidar_port, double band, int stride);
+                        const Eigen::Isometry3d& T_lidar_port, double band, const Sampling& sampling);
 
   AdapterGeometry geometry_;
   AdapterFitOptions options_;
