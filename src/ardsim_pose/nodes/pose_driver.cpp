@@ -70,6 +70,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/gate_acquisition_m", &i.gate_acquisition_m);
   read(nh, "icp/gate_min_m", &i.gate_min_m);
   read(nh, "icp/tukey_c", &i.tukey_c);
+  read(nh, "icp/weak_direction_condition", &i.weak_direction_condition);
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/converged_translation_m", &i.converged_translation_m);
   read(nh, "icp/converged_rotation_rad", &i.converged_rotation_rad);

@@ -69,6 +69,8 @@ void validate(const IcpOptions& o) {
   require(positive(o.gate_acquisition_m) && o.gate_acquisition_m >= o.gate_min_m, "icp/gate_acquisition_m",
           o.gate_acquisition_m, ">= gate_min_m");
   require(positive(o.tukey_c), "icp/tukey_c", o.tukey_c, "> 0");
+  require(fraction(o.weak_direction_condition), "icp/weak_direction_condition", o.weak_direction_condition,
+          "0 .. 1");
   require(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
   require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
           "> 0");
@@ -159,14 +161,19 @@ void IcpTracker::alignRange(Eigen::Isometry3d* T) {
   }
 }
 
-Eigen::Matrix<double, 6, 6> IcpTracker::leverScaled(const Eigen::Matrix<double, 6, 6>& H,
-                                                    const Eigen::Vector3d& centre) const {
+Eigen::Matrix<double, 6, 1> IcpTracker::leverScale(const Eigen::Vector3d& centre) const {
   // Rotations scaled by the correspondences' lever arm about centre, so that units compare.
   double lever_sq = 0.0;
   for (const Correspondence& c : correspondences_) lever_sq += (c.model - centre).squaredNorm();
   const double lever = std::sqrt(lever_sq / std::max<std::size_t>(1, correspondences_.size()));
   Eigen::Matrix<double, 6, 1> scale;
   scale << 1, 1, 1, 1.0 / lever, 1.0 / lever, 1.0 / lever;
+  return scale;
+}
+
+Eigen::Matrix<double, 6, 6> IcpTracker::leverScaled(const Eigen::Matrix<double, 6, 6>& H,
+                                                    const Eigen::Vector3d& centre) const {
+  const Eigen::Matrix<double, 6, 1> scale = leverScale(centre);
   return scale.asDiagonal() * H * scale.asDiagonal();
 }
 
@@ -175,6 +182,38 @@ bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, 
   // eigenvalue.
   const Eigen::Matrix<double, 6, 1> column = H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 1>::Unit(5));
   return largest > 0.0 && column(5) > 0.0 && 1.0 / column(5) / largest > options_.degraded_condition;
+}
+
+void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest,
+                                    const Eigen::Vector3d& centre,
+                                    const Eigen::Matrix<double, 6, 6>& H_tangential,
+                                    const Eigen::Matrix<double, 6, 1>& g_tangential,
+                                    Eigen::Matrix<double, 6, 1>* delta,
+                                    Eigen::Matrix<double, 6, 1>* weak_step) const {
+  // The plane fit's directions (lever-scaled) with less than weak_direction_condition of its largest
+  // information: the step there comes from the tangential offsets instead (none: held). Among the first five
+  // unknowns only: the boresight rotation keeps its own treatment (solved, or held when unobserved); on the
+  // near-symmetric docking adapter the tangential offsets turned it by 0.2 deg.
+  constexpr int kFree = 5;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kFree, kFree>> eigen(
+      H_scaled.topLeftCorner<kFree, kFree>());
+  int weak = 0;
+  while (weak < kFree && eigen.eigenvalues()(weak) < options_.weak_direction_condition * largest) ++weak;
+  if (weak == 0) return;
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(6, weak);  // scaled coordinates
+  U.topRows(kFree) = eigen.eigenvectors().leftCols(weak);
+  const Eigen::Matrix<double, 6, 1> scale = leverScale(centre);
+  const Eigen::MatrixXd D = scale.asDiagonal() * U;  // the same directions, unscaled
+  // The plane step's part in those directions, removed (in scaled coordinates, where U is orthonormal).
+  Eigen::Matrix<double, 6, 1> y = delta->cwiseQuotient(scale);
+  y -= U * (U.transpose() * y);
+  *delta = y.cwiseProduct(scale);
+  const Eigen::MatrixXd H_weak = D.transpose() * H_tangential * D;
+  const Eigen::VectorXd z = H_weak.ldlt().solve(D.transpose() * g_tangential);
+  if (z.allFinite() && H_weak.trace() > 0.0) {
+    *weak_step = D * z;
+    *delta += *weak_step;
+  }
 }
 
 double IcpTracker::imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) const {
@@ -290,6 +329,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       c.normal = R * model_->normals()[j].cast<double>();
       c.residual = c.normal.dot(c.scan - c.model);
       c.distance = std::sqrt(static_cast<double>(distance_sq));
+      c.spacing = model_->spacing()[j];
       correspondences_.push_back(c);
     }
     if (prune_unmatched) active_.resize(kept);
@@ -311,7 +351,11 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     // Normal equations of the point-to-plane residual for a twist (v, w) about `centre` (conditioning):
     // p' = p + w x (p - centre) + v.
     a.H.setZero();
+    Eigen::Matrix<double, 6, 6> H_tangential = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 6, 1> g_tangential = Eigen::Matrix<double, 6, 1>::Zero();
+    const bool tangential = options_.weak_direction_condition > 0.0;
+    const double pixel_pitch_rad = 1.0 / std::min(intrinsics_.fx, intrinsics_.fy);
     a.inliers = 0;
     a.inlier_sq_sum = 0.0;
     a.weight_sum = 0.0;
@@ -325,6 +369,22 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       J.tail<3>() = (c.model - a.centre).cross(c.normal);
       a.H.noalias() += w * J * J.transpose();
       g.noalias() += w * c.residual * J;
+      if (tangential) {
+        // The offset to the nearest model point across the normal, e = P (s - m) with P = 1 - n n^T, beyond
+        // the model's sample spacing and the pixel's footprint (inside a surface it is only the sampling:
+        // points past a rim or an edge give it); a twist moves it by -A (v, w), A = [P, -P [m - c]x].
+        const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - c.normal * c.normal.transpose();
+        const Eigen::Vector3d e = P * (c.scan - c.model);
+        const double e_norm = e.norm();
+        const double sampling = std::max(c.spacing, c.scan.norm() * pixel_pitch_rad);
+        if (e_norm > sampling) {
+          Eigen::Matrix<double, 3, 6> A;
+          A.leftCols<3>() = P;
+          A.rightCols<3>() = -P * skew(c.model - a.centre);
+          H_tangential.noalias() += w * A.transpose() * A;
+          g_tangential.noalias() += (w * (1.0 - sampling / e_norm)) * A.transpose() * e;
+        }
+      }
       ++a.inliers;
       a.inlier_sq_sum += c.residual * c.residual;
       a.weight_sum += w;
@@ -347,6 +407,11 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     } else {
       delta.head<5>() = a.H.topLeftCorner<5, 5>().ldlt().solve(g.head<5>());
     }
+    // The weak directions' part of the step (from the tangential offsets), judged on its own below.
+    Eigen::Matrix<double, 6, 1> weak_step = Eigen::Matrix<double, 6, 1>::Zero();
+    if (tangential) {
+      stepWeakDirections(H_scaled, largest, a.centre, H_tangential, g_tangential, &delta, &weak_step);
+    }
     if (!delta.allFinite()) {
       a.failure = "diverged: singular normal equations";
       return a;
@@ -365,7 +430,13 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
         selectActive(stride);
       }
     } else {
-      a.converged = v.norm() < options_.converged_translation_m && w.norm() < options_.converged_rotation_rad;
+      // The tangential offsets only creep to their end (a point counts once it is a spacing past the rim):
+      // their part of the step converges at kCoarseFactor x the thresholds.
+      const Eigen::Matrix<double, 6, 1> strong_step = delta - weak_step;
+      a.converged = strong_step.head<3>().norm() < options_.converged_translation_m &&
+                    strong_step.tail<3>().norm() < options_.converged_rotation_rad &&
+                    weak_step.head<3>().norm() < kCoarseFactor * options_.converged_translation_m &&
+                    weak_step.tail<3>().norm() < kCoarseFactor * options_.converged_rotation_rad;
     }
 
     scratch_.clear();

@@ -13,6 +13,7 @@
 #include "ardsim_pose/dataset.h"
 #include "ardsim_pose/estimator_factory.h"
 #include "ardsim_pose/evaluation.h"
+#include "ardsim_pose/icp_tracker.h"
 
 namespace ardsim_pose {
 namespace {
@@ -171,6 +172,37 @@ TEST_F(LostFrames, AnotherObjectIsLost) {
     estimator->setPrior(dockingAxisPose(TargetKind::kIss, d));
     const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.0));
     EXPECT_EQ(out.result.status, EstimateStatus::kLost) << d << " m: " << out.result.reason;
+  }
+}
+
+// Hubble's aft bulkhead seen face-on says nothing about sliding across it through the plane residuals; the
+// weak directions take their step from the offsets past its rim and the soft-capture mechanism's edges. The
+// tracker, tracking, is given predictions 0.15 m off across the boresight: it must come back to within 5 cm
+// (measured 1.8-3.7 cm; point-to-plane alone stayed 0.08-0.58 m off, once reported TRACKING at 0.15 m) and
+// never report TRACKING beyond the 2 cm goal.
+TEST(HubbleEndOn, APredictionOffAcrossTheBoresightIsCorrected) {
+  PoseConfig config;
+  config.target = TargetKind::kHubble;
+  const std::shared_ptr<const ReferenceModel> model = buildReferenceModel(TargetKind::kHubble, config.model);
+  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
+  simulator.setTarget(ardsim_description::buildHubble());
+  IcpTracker tracker(model, ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
+  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
+  ardsim_lidar::LidarFrame frame;
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, 29.0 - 0.01 * k);
+    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
+    Eigen::Isometry3d prediction = truth;
+    if (k >= 4) prediction.translation() += Eigen::Vector3d(0.12, -0.09, 0.0);  // lidar x, y
+    const PoseResult result = tracker.estimate(fromLidarFrame(frame, simulator.rays(), 0.1 * k), prediction);
+    SCOPED_TRACE("frame " + std::to_string(k));
+    ASSERT_NE(result.status, EstimateStatus::kLost) << result.reason;
+    if (k < 4) continue;
+    const PoseErrorValue e = poseError(result.T_lidar_target, truth, T_target_port);
+    EXPECT_LT(e.port_position_error_m.norm(), 0.05);
+    if (result.status == EstimateStatus::kTracking) {
+      EXPECT_LT(e.port_position_error_m.norm(), 0.02);
+    }
   }
 }
 

@@ -26,9 +26,14 @@ struct IcpOptions {
   int max_iterations_acquisition = 40;  // per frame while acquiring (from a prior or after LOST)
   double gate_tracking_m = 0.5;         // first correspondence gate when tracking
   double gate_acquisition_m = 3.0;      // first correspondence gate while acquiring
-  double gate_min_m = 0.3;    // the gate shrinks to 4 x the median correspondence distance, not below
-  double tukey_c = 4.685;     // Tukey biweight constant, in robust sigmas of the plane residuals
-  double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
+  double gate_min_m = 0.3;  // the gate shrinks to 4 x the median correspondence distance, not below
+  double tukey_c = 4.685;   // Tukey biweight constant, in robust sigmas of the plane residuals
+  // A plane seen face-on (Hubble's aft bulkhead) says nothing about sliding along it: in the directions where
+  // the plane residuals' information is below this fraction of the largest (lever-scaled), the step comes
+  // from the offsets to the nearest model points across their normals beyond the model's sample spacing
+  // (points past a rim or an edge), or is held where there are none. 0: point-to-plane only.
+  double weak_direction_condition = 0.01;
+  double min_sigma_m = 0.01;              // floor of the robust sigma (the sensor's range noise)
   double converged_translation_m = 1e-4;  // an update smaller than both ends the iterations
   double converged_rotation_rad = 1e-5;
   double revisibility_translation_m = 0.3;  // recompute the visibility when the pose moved more than this
@@ -122,6 +127,14 @@ class IcpTracker : public PoseMethod {
   // H with its rotation rows and columns scaled by the correspondences' lever arm about centre.
   Eigen::Matrix<double, 6, 6> leverScaled(const Eigen::Matrix<double, 6, 6>& H,
                                           const Eigen::Vector3d& centre) const;
+  // The diagonal of that scaling.
+  Eigen::Matrix<double, 6, 1> leverScale(const Eigen::Vector3d& centre) const;
+  // Replaces delta's part in the weak directions of H_scaled (see weak_direction_condition) by the
+  // Gauss-Newton step of the tangential offsets' normal equations there (also into weak_step).
+  void stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest,
+                          const Eigen::Vector3d& centre, const Eigen::Matrix<double, 6, 6>& H_tangential,
+                          const Eigen::Matrix<double, 6, 1>& g_tangential, Eigen::Matrix<double, 6, 1>* delta,
+                          Eigen::Matrix<double, 6, 1>* weak_step) const;
   // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the
   // boresight: its information with the other five free, over the largest eigenvalue, above
   // degraded_condition.
@@ -159,6 +172,7 @@ class IcpTracker : public PoseMethod {
     Eigen::Vector3d normal;  // lidar frame
     double residual;         // along the normal, m
     double distance;         // point to point, m
+    double spacing;          // the model's sample spacing there, m
   };
   std::vector<Correspondence> correspondences_;
   std::vector<double> scratch_;
