@@ -43,6 +43,12 @@ double median(std::vector<double>* values) {
   return *middle;
 }
 
+// Tukey's biweight of a residual against its limit (0 beyond it).
+double tukeyWeight(double residual, double limit) {
+  const double u = residual / limit;
+  return std::abs(u) < 1.0 ? (1.0 - u * u) * (1.0 - u * u) : 0.0;
+}
+
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
@@ -185,10 +191,7 @@ bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, 
 }
 
 void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest,
-                                    const Eigen::Vector3d& centre,
-                                    const Eigen::Matrix<double, 6, 6>& H_tangential,
-                                    const Eigen::Matrix<double, 6, 1>& g_tangential,
-                                    Eigen::Matrix<double, 6, 1>* delta,
+                                    const Alignment& a, Eigen::Matrix<double, 6, 1>* delta,
                                     Eigen::Matrix<double, 6, 1>* weak_step) const {
   // The plane fit's directions (lever-scaled) with less than weak_direction_condition of its largest
   // information: the step there comes from the tangential offsets instead (none: held). Among the first five
@@ -200,9 +203,33 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
   int weak = 0;
   while (weak < kFree && eigen.eigenvalues()(weak) < options_.weak_direction_condition * largest) ++weak;
   if (weak == 0) return;
+
+  // Normal equations of the offsets to the nearest model points across their normals, e = P (s - m) with
+  // P = 1 - n n^T, counted beyond the model's sample spacing and the pixel's footprint (inside a surface the
+  // offset is only the sampling: points past a rim or an edge give it), Tukey-weighted as the plane
+  // residuals; a twist moves e by -A (v, w), A = [P, -P [m - c]x]. Built only here: most ISS iterations have
+  // no weak direction.
+  const double pixel_pitch_rad = 1.0 / std::min(intrinsics_.fx, intrinsics_.fy);
+  Eigen::Matrix<double, 6, 6> H_tangential = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> g_tangential = Eigen::Matrix<double, 6, 1>::Zero();
+  for (const Correspondence& c : correspondences_) {
+    const double w = tukeyWeight(c.residual, a.limit_m);
+    if (w == 0.0) continue;
+    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - c.normal * c.normal.transpose();
+    const Eigen::Vector3d e = P * (c.scan - c.model);
+    const double e_norm = e.norm();
+    const double sampling = std::max(c.spacing, c.scan.norm() * pixel_pitch_rad);
+    if (e_norm <= sampling) continue;
+    Eigen::Matrix<double, 3, 6> A;
+    A.leftCols<3>() = P;
+    A.rightCols<3>() = -P * skew(c.model - a.centre);
+    H_tangential.noalias() += w * A.transpose() * A;
+    g_tangential.noalias() += (w * (1.0 - sampling / e_norm)) * A.transpose() * e;
+  }
+
   Eigen::MatrixXd U = Eigen::MatrixXd::Zero(6, weak);  // scaled coordinates
   U.topRows(kFree) = eigen.eigenvectors().leftCols(weak);
-  const Eigen::Matrix<double, 6, 1> scale = leverScale(centre);
+  const Eigen::Matrix<double, 6, 1> scale = leverScale(a.centre);
   const Eigen::MatrixXd D = scale.asDiagonal() * U;  // the same directions, unscaled
   // The plane step's part in those directions, removed (in scaled coordinates, where U is orthonormal).
   Eigen::Matrix<double, 6, 1> y = delta->cwiseQuotient(scale);
@@ -351,40 +378,19 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     // Normal equations of the point-to-plane residual for a twist (v, w) about `centre` (conditioning):
     // p' = p + w x (p - centre) + v.
     a.H.setZero();
-    Eigen::Matrix<double, 6, 6> H_tangential = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    Eigen::Matrix<double, 6, 1> g_tangential = Eigen::Matrix<double, 6, 1>::Zero();
-    const bool tangential = options_.weak_direction_condition > 0.0;
-    const double pixel_pitch_rad = 1.0 / std::min(intrinsics_.fx, intrinsics_.fy);
     a.inliers = 0;
     a.inlier_sq_sum = 0.0;
     a.weight_sum = 0.0;
     a.weighted_sq_sum = 0.0;
     for (const Correspondence& c : correspondences_) {
-      const double u = c.residual / limit;
-      if (std::abs(u) >= 1.0) continue;
-      const double w = (1.0 - u * u) * (1.0 - u * u);
+      const double w = tukeyWeight(c.residual, limit);
+      if (w == 0.0) continue;
       Eigen::Matrix<double, 6, 1> J;
       J.head<3>() = c.normal;
       J.tail<3>() = (c.model - a.centre).cross(c.normal);
       a.H.noalias() += w * J * J.transpose();
       g.noalias() += w * c.residual * J;
-      if (tangential) {
-        // The offset to the nearest model point across the normal, e = P (s - m) with P = 1 - n n^T, beyond
-        // the model's sample spacing and the pixel's footprint (inside a surface it is only the sampling:
-        // points past a rim or an edge give it); a twist moves it by -A (v, w), A = [P, -P [m - c]x].
-        const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - c.normal * c.normal.transpose();
-        const Eigen::Vector3d e = P * (c.scan - c.model);
-        const double e_norm = e.norm();
-        const double sampling = std::max(c.spacing, c.scan.norm() * pixel_pitch_rad);
-        if (e_norm > sampling) {
-          Eigen::Matrix<double, 3, 6> A;
-          A.leftCols<3>() = P;
-          A.rightCols<3>() = -P * skew(c.model - a.centre);
-          H_tangential.noalias() += w * A.transpose() * A;
-          g_tangential.noalias() += (w * (1.0 - sampling / e_norm)) * A.transpose() * e;
-        }
-      }
       ++a.inliers;
       a.inlier_sq_sum += c.residual * c.residual;
       a.weight_sum += w;
@@ -409,9 +415,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     }
     // The weak directions' part of the step (from the tangential offsets), judged on its own below.
     Eigen::Matrix<double, 6, 1> weak_step = Eigen::Matrix<double, 6, 1>::Zero();
-    if (tangential) {
-      stepWeakDirections(H_scaled, largest, a.centre, H_tangential, g_tangential, &delta, &weak_step);
-    }
+    if (options_.weak_direction_condition > 0.0) stepWeakDirections(H_scaled, largest, a, &delta, &weak_step);
     if (!delta.allFinite()) {
       a.failure = "diverged: singular normal equations";
       return a;

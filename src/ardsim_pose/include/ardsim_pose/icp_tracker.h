@@ -130,11 +130,10 @@ class IcpTracker : public PoseMethod {
   // The diagonal of that scaling.
   Eigen::Matrix<double, 6, 1> leverScale(const Eigen::Vector3d& centre) const;
   // Replaces delta's part in the weak directions of H_scaled (see weak_direction_condition) by the
-  // Gauss-Newton step of the tangential offsets' normal equations there (also into weak_step).
-  void stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest,
-                          const Eigen::Vector3d& centre, const Eigen::Matrix<double, 6, 6>& H_tangential,
-                          const Eigen::Matrix<double, 6, 1>& g_tangential, Eigen::Matrix<double, 6, 1>* delta,
-                          Eigen::Matrix<double, 6, 1>* weak_step) const;
+  // Gauss-Newton step of the tangential offsets' normal equations there (also into weak_step), from the
+  // correspondences and the Tukey limit and centre of the iteration a.
+  void stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest, const Alignment& a,
+                          Eigen::Matrix<double, 6, 1>* delta, Eigen::Matrix<double, 6, 1>* weak_step) const;
   // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the
   // boresight: its information with the other five free, over the largest eigenvalue, above
   // degraded_condition.
