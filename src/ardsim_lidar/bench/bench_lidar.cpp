@@ -1,9 +1,19 @@
 // Frames per second of the flash LIDAR on the ISS from the docking axis (256 x 256, 20 deg, noise on):
 // BM_RenderIss_Ardsim renders with EGL (llvmpipe without a GPU) and BM_RenderIss_Embree casts the same pixel
 // rays through the same mesh with Embree 3 (rtcIntersect16, TBB); both then apply the same noise model.
+// One frame at a time, as in the closed loop (the next pose depends on this frame). The *Sequence* pair
+// makes kSequenceFrames frames of poses known ahead (render_dataset): EGL pipelined
+// (LidarSimulator::simulateSequence), Embree with frames in parallel over the cores.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <atomic>
 #include <memory>
+#include <utility>
+#include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 #include "ardsim_description/models.h"
 #include "ardsim_lidar/docking_views.h"
@@ -72,6 +82,58 @@ void BM_RenderIss_Embree(benchmark::State& state) {
   state.counters["returns"] = static_cast<double>(frame.returnCount());
 }
 
+constexpr std::size_t kSequenceFrames = 64;
+
+// The same view in every frame, each with its own noise.
+std::vector<Eigen::Isometry3d> sequenceAt(double range_m) {
+  return std::vector<Eigen::Isometry3d>(kSequenceFrames,
+                                        lidarOnDockingAxis(ardsim_description::TargetKind::kIss, range_m));
+}
+
+void BM_RenderIssSequence_Ardsim(benchmark::State& state) {
+  Fixture& f = fixture();
+  const std::vector<Eigen::Isometry3d> poses = sequenceAt(state.range(0));
+  std::uint64_t index = 0;
+  std::atomic<std::size_t> returns{0};
+  for (auto _ : state) {
+    f.simulator.simulateSequence(poses, index, [&](std::size_t, const LidarFrame& frame) {
+      returns.store(frame.returnCount(), std::memory_order_relaxed);
+    });
+    index += poses.size();
+  }
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * poses.size()), benchmark::Counter::kIsRate);
+  state.counters["returns"] = static_cast<double>(returns.load());
+  // The rendering thread's time per frame (last sequence): what bounds the pipeline when the cores keep up.
+  const SequenceTiming& timing = f.simulator.renderer().lastSequenceTiming();
+  const double frames = static_cast<double>(std::max<std::size_t>(1, timing.frames));
+  state.counters["submit_ms"] = timing.submit_ms / frames;
+  state.counters["wait_ms"] = timing.wait_ms / frames;
+  state.counters["copy_ms"] = timing.copy_ms / frames;
+  state.counters["handoff_ms"] = timing.consume_ms / frames;
+}
+
+void BM_RenderIssSequence_Embree(benchmark::State& state) {
+  Fixture& f = fixture();
+  const std::vector<Eigen::Isometry3d> poses = sequenceAt(state.range(0));
+  std::uint64_t index = 0;
+  std::atomic<std::size_t> returns{0};
+  // Frames reused per thread, as the EGL path reuses its slots.
+  tbb::enumerable_thread_specific<std::pair<RenderedFrame, LidarFrame>> buffers;
+  for (auto _ : state) {
+    tbb::parallel_for(std::size_t{0}, poses.size(), [&](std::size_t k) {
+      auto& [rendered, frame] = buffers.local();
+      f.caster.cast(poses[k], &rendered);
+      f.noise_model.apply(rendered, f.mesh.materials, index + k, &frame);
+      returns.store(frame.returnCount(), std::memory_order_relaxed);
+    });
+    index += poses.size();
+  }
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * poses.size()), benchmark::Counter::kIsRate);
+  state.counters["returns"] = static_cast<double>(returns.load());
+}
+
 // Wall time: llvmpipe and Embree both work on threads other than the benchmark's.
 BENCHMARK(BM_RenderIss_Ardsim)
     ->Arg(100)
@@ -81,6 +143,20 @@ BENCHMARK(BM_RenderIss_Ardsim)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_RenderIss_Embree)
+    ->Arg(100)
+    ->Arg(30)
+    ->Arg(10)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_RenderIssSequence_Ardsim)
+    ->Arg(100)
+    ->Arg(30)
+    ->Arg(10)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_RenderIssSequence_Embree)
     ->Arg(100)
     ->Arg(30)
     ->Arg(10)

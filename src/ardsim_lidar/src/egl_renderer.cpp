@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
@@ -17,6 +19,19 @@
 namespace ardsim_lidar {
 
 namespace {
+
+// renderSequence keeps this many frames queued on the GPU (drawn, their readback under way) while the
+// caller handles the oldest: enough to hide the GPU's latency behind the CPU's work per frame.
+constexpr std::size_t kFramesInFlight = 8;
+
+using Clock = std::chrono::steady_clock;
+// Milliseconds since *start, which moves to now.
+double millisecondsSince(Clock::time_point* start) {
+  const Clock::time_point now = Clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - *start).count();
+  *start = now;
+  return ms;
+}
 
 constexpr const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position_target;
@@ -139,6 +154,9 @@ struct EglRenderer::Impl {
   GLuint framebuffer = 0;
   GLuint colour_renderbuffer = 0;
   GLuint depth_renderbuffer = 0;
+  // Pixel buffer objects of renderSequence: frames in flight, read back asynchronously.
+  std::array<GLuint, kFramesInFlight> pixel_buffers{};
+  std::array<const void*, kFramesInFlight> pixel_buffer_maps{};  // persistent mappings, or null
   GLint uniform_T_lidar_target = -1;
   GLint uniform_projection = -1;
   GLint uniform_R_lidar_target = -1;
@@ -147,6 +165,7 @@ struct EglRenderer::Impl {
 
   std::vector<Chunk> chunks;
   std::size_t triangles_drawn = 0;
+  SequenceTiming sequence_timing;
   std::array<float, 16> projection{};  // column-major
   std::array<Eigen::Vector3d, 4>
       side_plane_normals;  // inward normals of the frustum's side planes, lidar frame
@@ -297,6 +316,80 @@ struct EglRenderer::Impl {
     glFrontFace(GL_CW);
     glViewport(0, 0, sensor.width, sensor.height);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
+
+    // Pixel buffers for renderSequence. With buffer storage (OpenGL 4.4) they are mapped once, persistently,
+    // in client memory: mapping a buffer per frame cost NVIDIA's driver ~0.3 ms per 1 MB frame (page faults).
+    bool buffer_storage = major > 4 || (major == 4 && minor >= 4);
+    for (GLint i = 0; i < extension_count && !buffer_storage; ++i)
+      buffer_storage = std::strcmp(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i)),
+                                   "GL_ARB_buffer_storage") == 0;
+    glGenBuffers(static_cast<GLsizei>(pixel_buffers.size()), pixel_buffers.data());
+    for (std::size_t slot = 0; slot < pixel_buffers.size(); ++slot) {
+      const GLsizeiptr bytes = static_cast<GLsizeiptr>(frameBytes());
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, pixel_buffers[slot]);
+      if (buffer_storage) {
+        const GLbitfield access = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+        glBufferStorage(GL_PIXEL_PACK_BUFFER, bytes, nullptr, access | GL_CLIENT_STORAGE_BIT);
+        pixel_buffer_maps[slot] = glMapBufferRange(GL_PIXEL_PACK_BUFFER, 0, bytes, access);
+      } else {
+        glBufferData(GL_PIXEL_PACK_BUFFER, bytes, nullptr, GL_STREAM_READ);
+      }
+    }
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    if (glGetError() != GL_NO_ERROR) throw std::runtime_error("OpenGL: creating the pixel buffers failed");
+  }
+
+  std::size_t pixelCount() const { return static_cast<std::size_t>(sensor.width) * sensor.height; }
+  std::size_t frameBytes() const { return pixelCount() * sizeof(SurfaceSample); }
+
+  // Clears the framebuffer and draws the chunks in the view (context current).
+  void draw(const Eigen::Isometry3d& T_lidar_target) {
+    // Double precision up to here; the float matrix only carries target-frame vertices of a few tens of
+    // metres.
+    const Eigen::Matrix4f T = T_lidar_target.matrix().cast<float>();
+    const Eigen::Matrix3f R = T_lidar_target.linear().cast<float>();
+
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    const GLfloat no_surface[] = {0.0f, 0.0f, -1.0f, 0.0f};
+    glClearBufferfv(GL_COLOR, 0, no_surface);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    triangles_drawn = 0;
+    if (chunks.empty()) return;
+    glUseProgram(program);
+    glUniformMatrix4fv(uniform_T_lidar_target, 1, GL_FALSE, T.data());
+    glUniformMatrix4fv(uniform_projection, 1, GL_FALSE, projection.data());
+    glUniformMatrix3fv(uniform_R_lidar_target, 1, GL_FALSE, R.data());
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_BUFFER, triangle_texture);
+    glUniform1i(uniform_triangle_buffer, 0);
+    glBindVertexArray(vertex_array);
+    // Visible chunks are merged into contiguous runs, one draw call per run.
+    std::size_t run_first = 0;
+    std::size_t run_count = 0;
+    auto flush = [&]() {
+      if (run_count == 0) return;
+      glUniform1i(uniform_first_triangle, static_cast<GLint>(run_first));
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * run_count), GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(3 * run_first * sizeof(GLuint)));
+      triangles_drawn += run_count;
+      run_count = 0;
+    };
+    for (const Chunk& chunk : chunks) {
+      if (!chunkVisible(chunk, T_lidar_target)) {
+        flush();
+        continue;
+      }
+      if (run_count == 0) run_first = chunk.first_triangle;
+      run_count += chunk.triangle_count;
+    }
+    flush();
+  }
+
+  void checkErrors(const char* what) const {
+    const GLenum error = glGetError();
+    if (error != GL_NO_ERROR)
+      throw std::runtime_error(std::string("OpenGL: ") + what + " failed with error " +
+                               std::to_string(error));
   }
 
   void setUpProjection() {
@@ -358,6 +451,7 @@ EglRenderer::~EglRenderer() {
       const GLuint renderbuffers[] = {impl_->colour_renderbuffer, impl_->depth_renderbuffer};
       glDeleteRenderbuffers(2, renderbuffers);
       glDeleteFramebuffers(1, &impl_->framebuffer);
+      glDeleteBuffers(static_cast<GLsizei>(impl_->pixel_buffers.size()), impl_->pixel_buffers.data());
       eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     }
     eglDestroyContext(impl_->display, impl_->context);
@@ -433,53 +527,88 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
 void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame) {
   Impl& impl = *impl_;
   Impl::Current current(impl);
-  // Double precision up to here; the float matrix only carries target-frame vertices of a few tens of metres.
-  const Eigen::Matrix4f T = T_lidar_target.matrix().cast<float>();
-  const Eigen::Matrix3f R = T_lidar_target.linear().cast<float>();
-
-  glBindFramebuffer(GL_FRAMEBUFFER, impl.framebuffer);
-  const GLfloat no_surface[] = {0.0f, 0.0f, -1.0f, 0.0f};
-  glClearBufferfv(GL_COLOR, 0, no_surface);
-  glClear(GL_DEPTH_BUFFER_BIT);
-  impl.triangles_drawn = 0;
-  if (!impl.chunks.empty()) {
-    glUseProgram(impl.program);
-    glUniformMatrix4fv(impl.uniform_T_lidar_target, 1, GL_FALSE, T.data());
-    glUniformMatrix4fv(impl.uniform_projection, 1, GL_FALSE, impl.projection.data());
-    glUniformMatrix3fv(impl.uniform_R_lidar_target, 1, GL_FALSE, R.data());
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_BUFFER, impl.triangle_texture);
-    glUniform1i(impl.uniform_triangle_buffer, 0);
-    glBindVertexArray(impl.vertex_array);
-    // Visible chunks are merged into contiguous runs, one draw call per run.
-    std::size_t run_first = 0;
-    std::size_t run_count = 0;
-    auto flush = [&]() {
-      if (run_count == 0) return;
-      glUniform1i(impl.uniform_first_triangle, static_cast<GLint>(run_first));
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * run_count), GL_UNSIGNED_INT,
-                     reinterpret_cast<const void*>(3 * run_first * sizeof(GLuint)));
-      impl.triangles_drawn += run_count;
-      run_count = 0;
-    };
-    for (const Chunk& chunk : impl.chunks) {
-      if (!impl.chunkVisible(chunk, T_lidar_target)) {
-        flush();
-        continue;
-      }
-      if (run_count == 0) run_first = chunk.first_triangle;
-      run_count += chunk.triangle_count;
-    }
-    flush();
-  }
+  impl.draw(T_lidar_target);
   frame->width = impl.sensor.width;
   frame->height = impl.sensor.height;
-  frame->pixels.resize(static_cast<std::size_t>(impl.sensor.width) * impl.sensor.height);
+  frame->pixels.resize(impl.pixelCount());
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, impl.sensor.width, impl.sensor.height, GL_RGBA, GL_FLOAT, frame->pixels.data());
-  const GLenum error = glGetError();
-  if (error != GL_NO_ERROR)
-    throw std::runtime_error("OpenGL: rendering failed with error " + std::to_string(error));
+  impl.checkErrors("rendering");
+}
+
+void EglRenderer::renderSequence(const std::vector<Eigen::Isometry3d>& T_lidar_target,
+                                 const std::function<void(std::size_t, RenderedFrame&)>& consume) {
+  Impl& impl = *impl_;
+  Impl::Current current(impl);
+  std::array<GLsync, kFramesInFlight> fences{};
+  auto deleteFences = [&fences]() {
+    for (GLsync& fence : fences) {
+      if (fence != nullptr) glDeleteSync(fence);
+      fence = nullptr;
+    }
+  };
+  RenderedFrame frame;
+  // Waits for frame k's readback, copies it out of its pixel buffer and hands it over.
+  SequenceTiming& timing = impl.sequence_timing;
+  timing = SequenceTiming{};
+  timing.frames = T_lidar_target.size();
+  auto retrieve = [&](std::size_t k) {
+    const std::size_t slot = k % kFramesInFlight;
+    auto start = Clock::now();
+    while (glClientWaitSync(fences[slot], GL_SYNC_FLUSH_COMMANDS_BIT, 1000000000) == GL_TIMEOUT_EXPIRED) {
+    }
+    timing.wait_ms += millisecondsSince(&start);
+    glDeleteSync(fences[slot]);
+    fences[slot] = nullptr;
+    const void* persistent = impl.pixel_buffer_maps[slot];
+    const void* pixels = persistent;
+    if (persistent == nullptr) {
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, impl.pixel_buffers[slot]);
+      pixels = glMapBufferRange(GL_PIXEL_PACK_BUFFER, 0, static_cast<GLsizeiptr>(impl.frameBytes()),
+                                GL_MAP_READ_BIT);
+      if (pixels == nullptr) {
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+        throw std::runtime_error("OpenGL: mapping the pixel buffer failed with error " +
+                                 std::to_string(glGetError()));
+      }
+    }
+    frame.width = impl.sensor.width;  // again: consume may have swapped the frame out
+    frame.height = impl.sensor.height;
+    frame.pixels.resize(impl.pixelCount());
+    std::memcpy(frame.pixels.data(), pixels, impl.frameBytes());
+    if (persistent == nullptr) {
+      glUnmapBuffer(GL_PIXEL_PACK_BUFFER);
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    }
+    timing.copy_ms += millisecondsSince(&start);
+    consume(k, frame);
+    timing.consume_ms += millisecondsSince(&start);
+  };
+  try {
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    for (std::size_t k = 0; k < T_lidar_target.size(); ++k) {
+      if (k >= kFramesInFlight) retrieve(k - kFramesInFlight);
+      auto start = Clock::now();
+      impl.draw(T_lidar_target[k]);
+      const std::size_t slot = k % kFramesInFlight;
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, impl.pixel_buffers[slot]);
+      glReadPixels(0, 0, impl.sensor.width, impl.sensor.height, GL_RGBA, GL_FLOAT, nullptr);
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+      fences[slot] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+      impl.checkErrors("rendering");
+      glFlush();  // start the GPU on it now, not when the queue fills
+      timing.submit_ms += millisecondsSince(&start);
+    }
+    const std::size_t count = T_lidar_target.size();
+    for (std::size_t k = count > kFramesInFlight ? count - kFramesInFlight : 0; k < count; ++k) retrieve(k);
+  } catch (...) {
+    deleteFences();
+    throw;
+  }
+}
+
+const SequenceTiming& EglRenderer::lastSequenceTiming() const {
+  return impl_->sequence_timing;
 }
 
 const std::string& EglRenderer::glRenderer() const {

@@ -1,5 +1,8 @@
 #include "ardsim_lidar/lidar_simulator.h"
 
+#include <tbb/concurrent_queue.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -35,6 +38,49 @@ void LidarSimulator::simulate(const Eigen::Isometry3d& T_lidar_target, std::uint
   const auto noise_start = std::chrono::steady_clock::now();
   noise_model_.apply(rendered_, materials_, frame_index, frame);
   timing_.noise_ms = millisecondsSince(noise_start);
+}
+
+void LidarSimulator::simulateSequence(const std::vector<Eigen::Isometry3d>& T_lidar_target,
+                                      std::uint64_t first_frame_index,
+                                      const std::function<void(std::size_t, const LidarFrame&)>& consume) {
+  // Frames in the noise stage at once: enough to keep every core busy while the GPU renders ahead. A frame
+  // takes a free slot (waiting for one if need be) and gives it back when its consumer returns.
+  const int threads = tbb::this_task_arena::max_concurrency();
+  // The slots are kept from call to call: a fresh 1 MB frame costs its page faults (0.3 ms on the GPU
+  // machine).
+  const std::size_t slot_count = 2 * static_cast<std::size_t>(threads);
+  std::vector<SequenceSlot>& slots = sequence_slots_;
+  if (slots.size() < slot_count) slots.resize(slot_count);
+  tbb::concurrent_bounded_queue<std::size_t> free_slots;
+  for (std::size_t s = 0; s < slot_count; ++s) free_slots.push(s);
+  tbb::task_group tasks;
+  try {
+    renderer_.renderSequence(T_lidar_target, [&](std::size_t k, RenderedFrame& rendered) {
+      std::size_t s = 0;
+      // Without worker threads the tasks run only inside wait(): never block on the queue then.
+      while (!free_slots.try_pop(s)) {
+        if (threads > 1) {
+          free_slots.pop(s);
+          break;
+        }
+        tasks.wait();
+      }
+      std::swap(slots[s].rendered, rendered);
+      tasks.run([this, &slots, &free_slots, &consume, s, k, first_frame_index] {
+        struct Release {
+          tbb::concurrent_bounded_queue<std::size_t>& queue;
+          std::size_t slot;
+          ~Release() { queue.push(slot); }
+        } release{free_slots, s};
+        noise_model_.apply(slots[s].rendered, materials_, first_frame_index + k, &slots[s].frame);
+        consume(k, slots[s].frame);
+      });
+    });
+  } catch (...) {
+    tasks.wait();
+    throw;
+  }
+  tasks.wait();
 }
 
 void toPointCloud(const LidarFrame& frame, const PixelRays& rays, pcl::PointCloud<pcl::PointXYZI>* cloud) {

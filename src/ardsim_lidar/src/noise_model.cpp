@@ -7,7 +7,13 @@
 #include <sstream>
 #include <stdexcept>
 
+// philox.h first: it defines the feature macros MicroURNG.hpp uses.
+#include <Random123/philox.h>
+
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <Random123/MicroURNG.hpp>
+#include <boost/random/normal_distribution.hpp>
 
 namespace ardsim_lidar {
 
@@ -22,8 +28,31 @@ void require(bool ok, const std::string& name, double value, const std::string& 
   throw std::invalid_argument(message.str());
 }
 
-// Rows are processed in fixed blocks, each with its own random stream, so blocks can run in parallel and the
-// frame does not depend on the number of threads.
+// Per-frame randomness is counter-based (Philox4x64-10, Random123): every draw is a function of (seed, frame,
+// stream, index) alone, so pixels can be processed in any order on any number of threads and a frame is the
+// same whatever order frames are made in. Each pixel has its own stream (no per-block generator seeding).
+using Philox = r123::Philox4x64;
+using CounterRng = r123::MicroURNG<Philox>;
+
+enum class Stream : std::uint64_t {
+  kPixel = 0,  // index = pixel: return coin, mixed pixel, range noise
+  kBloom = 1,  // index = saturated retro-reflector pixel: its spill into the neighbours
+  kFrame = 2,  // index 0: background returns and hot pixels, drawn sequentially
+};
+
+CounterRng streamOf(std::uint64_t seed, std::uint64_t frame_index, Stream stream, std::uint64_t index) {
+  // MicroURNG counts in the high 32 bits of the last counter word.
+  return CounterRng(Philox::ctr_type{{index, frame_index, static_cast<std::uint64_t>(stream), 0}},
+                    Philox::ukey_type{{seed, 0}});
+}
+
+// Uniform in [0, 1) from the top 53 bits.
+double uniform01(CounterRng& rng) {
+  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
+}
+
+// Bloom sources are gathered per block of rows and joined in row order, so their order does not depend on
+// scheduling.
 constexpr int kRowsPerBlock = 16;
 
 bool inClosed(double value, double low, double high) {
@@ -158,69 +187,66 @@ void NoiseModel::apply(const RenderedFrame& rendered,
 
   const int block_count = (height + kRowsPerBlock - 1) / kRowsPerBlock;
   std::vector<std::vector<int>> saturated_retro_pixels(block_count);
-  tbb::parallel_for(0, block_count, [&](int block) {
-    // Stream 0 is the frame's sequential stream (below); block b uses stream b + 1.
-    std::seed_seq sequence{low32(seed_), high32(seed_), low32(frame_index), high32(frame_index),
-                           static_cast<std::uint32_t>(block + 1)};
-    std::mt19937_64 rng(sequence);
-    std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    std::normal_distribution<double> normal(0.0, 1.0);
-    const int last_row = std::min(height, (block + 1) * kRowsPerBlock);
-    for (int v = block * kRowsPerBlock; v < last_row; ++v) {
-      for (int u = 0; u < width; ++u) {
-        const int i = v * width + u;
-        const SurfaceSample& sample = rendered.pixels[i];
-        // Surfaces closer than min_range are in the detector's blind zone: they hide what is behind but do
-        // not return.
-        if (!(sample.range_m >= min_range && sample.range_m <= max_range)) continue;
-        const ardsim_description::Material& material = materialOf(sample);
-        const bool retro = options_.retro_reflectors && material.retro_reflector &&
-                           sample.cos_incidence >= cos_retro_acceptance_;
-        if (options_.incidence_cutoff && !retro && sample.cos_incidence < cos_max_incidence_) continue;
-        const double s =
-            strength(material.reflectivity, sample.cos_incidence, material.retro_reflector, sample.range_m);
-        // Beyond s = 40 the probability is 1 to double precision: no draw needed (most close-range pixels).
-        if (options_.return_probability && s < 40.0 && uniform(rng) >= returnProbability(s)) continue;
+  tbb::parallel_for(tbb::blocked_range<int>(0, block_count), [&](const tbb::blocked_range<int>& blocks) {
+    // Ziggurat (Boost): a table look-up and one draw for most samples, where std's polar method needs a log.
+    boost::random::normal_distribution<double> normal(0.0, 1.0);
+    for (int block = blocks.begin(); block != blocks.end(); ++block) {
+      const int last_row = std::min(height, (block + 1) * kRowsPerBlock);
+      for (int v = block * kRowsPerBlock; v < last_row; ++v) {
+        for (int u = 0; u < width; ++u) {
+          const int i = v * width + u;
+          const SurfaceSample& sample = rendered.pixels[i];
+          // Surfaces closer than min_range are in the detector's blind zone: they hide what is behind but do
+          // not return.
+          if (!(sample.range_m >= min_range && sample.range_m <= max_range)) continue;
+          const ardsim_description::Material& material = materialOf(sample);
+          const bool retro = options_.retro_reflectors && material.retro_reflector &&
+                             sample.cos_incidence >= cos_retro_acceptance_;
+          if (options_.incidence_cutoff && !retro && sample.cos_incidence < cos_max_incidence_) continue;
+          const double s =
+              strength(material.reflectivity, sample.cos_incidence, material.retro_reflector, sample.range_m);
+          CounterRng rng = streamOf(seed_, frame_index, Stream::kPixel, static_cast<std::uint64_t>(i));
+          // Beyond s = 40 the probability is 1 to double precision: no draw needed (most close-range pixels).
+          if (options_.return_probability && s < 40.0 && uniform01(rng) >= returnProbability(s)) continue;
 
-        double range = sample.range_m;
-        if (options_.mixed_pixels) {
-          // The neighbour across the largest depth jump: the pixel's footprint straddles both surfaces.
-          double jump = 0.0;
-          const int neighbours[4][2] = {{u - 1, v}, {u + 1, v}, {u, v - 1}, {u, v + 1}};
-          for (const auto& n : neighbours) {
-            if (n[0] < 0 || n[0] >= width || n[1] < 0 || n[1] >= height) continue;
-            const SurfaceSample& other = rendered.pixels[n[1] * width + n[0]];
-            if (other.range_m <= 0.0f) continue;
-            const double difference = other.range_m - sample.range_m;
-            if (std::abs(difference) > std::abs(jump)) jump = difference;
+          double range = sample.range_m;
+          if (options_.mixed_pixels) {
+            // The neighbour across the largest depth jump: the pixel's footprint straddles both surfaces.
+            double jump = 0.0;
+            const int neighbours[4][2] = {{u - 1, v}, {u + 1, v}, {u, v - 1}, {u, v + 1}};
+            for (const auto& n : neighbours) {
+              if (n[0] < 0 || n[0] >= width || n[1] < 0 || n[1] >= height) continue;
+              const SurfaceSample& other = rendered.pixels[n[1] * width + n[0]];
+              if (other.range_m <= 0.0f) continue;
+              const double difference = other.range_m - sample.range_m;
+              if (std::abs(difference) > std::abs(jump)) jump = difference;
+            }
+            if (std::abs(jump) > options_.mixed_pixel_min_jump_m &&
+                uniform01(rng) < options_.mixed_pixel_probability)
+              range += uniform01(rng) * jump;
           }
-          if (std::abs(jump) > options_.mixed_pixel_min_jump_m &&
-              uniform(rng) < options_.mixed_pixel_probability)
-            range += uniform(rng) * jump;
+          if (options_.range_noise) range += rangeSigma(s) * normal(rng);
+          const double return_intensity = intensity(s);
+          const bool saturated = s >= saturation_strength_;
+          if (options_.saturation && saturated) range += options_.saturation_range_bias_m;
+          if (!(range >= min_range && range <= max_range)) continue;
+          frame->range_m[i] = static_cast<float>(range);
+          frame->intensity[i] = static_cast<float>(return_intensity);
+          if (options_.blooming && retro && saturated) saturated_retro_pixels[block].push_back(i);
         }
-        if (options_.range_noise) range += rangeSigma(s) * normal(rng);
-        const double return_intensity = intensity(s);
-        const bool saturated = s >= saturation_strength_;
-        if (options_.saturation && saturated) range += options_.saturation_range_bias_m;
-        if (!(range >= min_range && range <= max_range)) continue;
-        frame->range_m[i] = static_cast<float>(range);
-        frame->intensity[i] = static_cast<float>(return_intensity);
-        if (options_.blooming && retro && saturated) saturated_retro_pixels[block].push_back(i);
       }
     }
   });
 
-  std::seed_seq sequence{low32(seed_), high32(seed_), low32(frame_index), high32(frame_index), 0u};
-  std::mt19937_64 rng(sequence);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-
   // Blooming: light from a saturated retro-reflector spills into neighbours that have a weaker (or no)
   // return.
   const int radius = options_.bloom_radius_px;
-  std::vector<int> bloom_sources;  // in block order, so the draws below do not depend on scheduling
+  std::vector<int>
+      bloom_sources;  // in row order: where spills overlap, the result does not depend on threads
   for (const auto& block : saturated_retro_pixels)
     bloom_sources.insert(bloom_sources.end(), block.begin(), block.end());
   for (const int source : bloom_sources) {
+    CounterRng rng = streamOf(seed_, frame_index, Stream::kBloom, static_cast<std::uint64_t>(source));
     const int su = source % width;
     const int sv = source / width;
     for (int dv = -radius; dv <= radius; ++dv) {
@@ -230,7 +256,7 @@ void NoiseModel::apply(const RenderedFrame& rendered,
         const int nv = sv + dv;
         if (distance == 0 || nu < 0 || nu >= width || nv < 0 || nv >= height) continue;
         const double probability = options_.bloom_probability * (radius + 1 - distance) / radius;
-        if (uniform(rng) >= probability) continue;
+        if (uniform01(rng) >= probability) continue;
         const int j = nv * width + nu;
         const float bloom_intensity = std::ldexp(1.0f, -distance);
         if (std::isnan(frame->intensity[j]) || frame->intensity[j] < bloom_intensity) {
@@ -241,6 +267,7 @@ void NoiseModel::apply(const RenderedFrame& rendered,
     }
   }
 
+  CounterRng rng = streamOf(seed_, frame_index, Stream::kFrame, 0);
   // Background: rare and independent per pixel, so draw the gap to the next one (geometric) instead of a coin
   // per pixel. A spurious return comes before the true one (it triggers the detector first).
   if (options_.background_returns && options_.background_probability > 0.0) {
@@ -248,15 +275,15 @@ void NoiseModel::apply(const RenderedFrame& rendered,
     for (long i = gap(rng); i < pixel_count; i += 1 + static_cast<long>(gap(rng))) {
       const double upper = std::isnan(frame->range_m[i]) ? sensor_.max_range_m : frame->range_m[i];
       frame->range_m[i] =
-          static_cast<float>(sensor_.min_range_m + uniform(rng) * (upper - sensor_.min_range_m));
-      frame->intensity[i] = static_cast<float>(uniform(rng) * options_.background_intensity);
+          static_cast<float>(sensor_.min_range_m + uniform01(rng) * (upper - sensor_.min_range_m));
+      frame->intensity[i] = static_cast<float>(uniform01(rng) * options_.background_intensity);
     }
   }
   for (int i = 0; i < pixel_count; ++i) {
     if (options_.hot_pixels && hot_[i]) {
       frame->range_m[i] = static_cast<float>(sensor_.min_range_m +
-                                             uniform(rng) * (sensor_.max_range_m - sensor_.min_range_m));
-      frame->intensity[i] = static_cast<float>(uniform(rng));
+                                             uniform01(rng) * (sensor_.max_range_m - sensor_.min_range_m));
+      frame->intensity[i] = static_cast<float>(uniform01(rng));
     }
     if (options_.dead_pixels && dead_[i]) {
       frame->range_m[i] = kNoReturn;

@@ -1,5 +1,6 @@
 // render_dataset: renders the target at every pose of a list and writes, per pose, an organized binary PCD
 // and a 16-bit range PNG, plus truth.csv. See README.md. Errors: one line on stderr, exit status 2.
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -110,41 +111,46 @@ int run(int argc, char** argv) {
   truth << "# frame x y z qx qy qz qw: T_lidar_target (pose of target in lidar_optical), m\n";
   truth.precision(17);
 
-  ardsim_lidar::LidarFrame frame;
-  pcl::PointCloud<pcl::PointXYZI> cloud;
-  cv::Mat range_mm(args.sensor.height, args.sensor.width, CV_16UC1);
-  std::size_t clipped = 0;
+  // Frames are made pipelined (the GPU renders ahead while earlier frames get their noise and are written,
+  // several at once); each is seeded by its row index, so the files are those of one-at-a-time rendering.
+  std::vector<Eigen::Isometry3d> T_lidar_target;
+  for (const auto& row : poses) T_lidar_target.push_back(row.T_lidar_target);
+  std::atomic<std::size_t> clipped{0};
+  simulator.simulateSequence(
+      T_lidar_target, 0, [&](std::size_t index, const ardsim_lidar::LidarFrame& frame) {
+        pcl::PointCloud<pcl::PointXYZI> cloud;
+        ardsim_lidar::toPointCloud(frame, simulator.rays(), &cloud);
+        const std::string pcd_path = (out / frameName(index, "pcd")).string();
+        if (pcl::io::savePCDFileBinary(pcd_path, cloud) != 0)
+          throw std::runtime_error("cannot write " + pcd_path);
+        cv::Mat range_mm(frame.height, frame.width, CV_16UC1);
+        for (int v = 0; v < frame.height; ++v) {
+          for (int u = 0; u < frame.width; ++u) {
+            const float range = frame.range_m[static_cast<std::size_t>(v) * frame.width + u];
+            double millimetres = std::isnan(range) ? 0.0 : std::round(1000.0 * range);  // 0 = no return
+            if (millimetres > 65535.0) {
+              millimetres = 65535.0;  // 16-bit millimetres end at 65.535 m
+              clipped.fetch_add(1, std::memory_order_relaxed);
+            }
+            range_mm.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(millimetres);
+          }
+        }
+        const std::string png_path = (out / frameName(index, "png")).string();
+        if (!cv::imwrite(png_path, range_mm)) throw std::runtime_error("cannot write " + png_path);
+      });
   for (std::size_t index = 0; index < poses.size(); ++index) {
     const Eigen::Isometry3d& T = poses[index].T_lidar_target;
-    simulator.simulate(T, index, &frame);
-    ardsim_lidar::toPointCloud(frame, simulator.rays(), &cloud);
-    const std::string pcd_path = (out / frameName(index, "pcd")).string();
-    if (pcl::io::savePCDFileBinary(pcd_path, cloud) != 0)
-      throw std::runtime_error("cannot write " + pcd_path);
-    for (int v = 0; v < frame.height; ++v) {
-      for (int u = 0; u < frame.width; ++u) {
-        const float range = frame.range_m[static_cast<std::size_t>(v) * frame.width + u];
-        double millimetres = std::isnan(range) ? 0.0 : std::round(1000.0 * range);  // 0 = no return
-        if (millimetres > 65535.0) {
-          millimetres = 65535.0;  // 16-bit millimetres end at 65.535 m
-          ++clipped;
-        }
-        range_mm.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(millimetres);
-      }
-    }
-    const std::string png_path = (out / frameName(index, "png")).string();
-    if (!cv::imwrite(png_path, range_mm)) throw std::runtime_error("cannot write " + png_path);
     const Eigen::Quaterniond q(T.linear());
     truth << index << ' ' << T.translation().x() << ' ' << T.translation().y() << ' ' << T.translation().z()
           << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << '\n';
   }
   std::printf("render_dataset: %zu frames in %s (%zu bad rows skipped; GL_RENDERER %s)\n", poses.size(),
               args.out.c_str(), errors.size(), simulator.renderer().glRenderer().c_str());
-  if (clipped > 0)
+  if (clipped.load() > 0)
     std::printf(
         "render_dataset: %zu returns beyond 65.535 m saturate the 16-bit PNG at 65535 mm (the PCD keeps "
         "them)\n",
-        clipped);
+        clipped.load());
   return 0;
 }
 

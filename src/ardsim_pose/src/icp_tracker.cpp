@@ -77,6 +77,7 @@ void validate(const IcpOptions& o) {
   require(positive(o.tukey_c), "icp/tukey_c", o.tukey_c, "> 0");
   require(fraction(o.weak_direction_condition), "icp/weak_direction_condition", o.weak_direction_condition,
           "0 .. 1");
+  require(positive(o.degraded_weak_slide_px), "icp/degraded_weak_slide_px", o.degraded_weak_slide_px, "> 0");
   require(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
   require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
           "> 0");
@@ -420,6 +421,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       a.failure = "diverged: singular normal equations";
       return a;
     }
+
     const Eigen::Vector3d v = delta.head<3>();
     const Eigen::Vector3d w = delta.tail<3>();
     Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
@@ -681,6 +683,14 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   if (result.fit_rms_m > options_.degraded_fit_rms_m)
     degraded.push_back(format("fit rms %.3f m", result.fit_rms_m));
   if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
+  const double footprint_m = T.translation().norm() / std::min(intrinsics_.fx, intrinsics_.fy);
+  if (options_.weak_direction_condition > 0.0 &&
+      correction_m > options_.degraded_weak_slide_px * footprint_m &&
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>(H_scaled.topLeftCorner<5, 5>(),
+                                                                 Eigen::EigenvaluesOnly)
+              .eigenvalues()(0) < options_.weak_direction_condition * largest)
+    degraded.push_back(format("weakly observed directions: %.3f m from the prediction > %.3f m", correction_m,
+                              options_.degraded_weak_slide_px * footprint_m));
   if (condition_of_the_rest < options_.degraded_condition)
     degraded.push_back(format("poorly constrained (condition %.1e)", condition));
   // Acquisition ends when a frame agrees with the one before (its prediction), or with the constant-velocity

@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -22,6 +24,16 @@ enum class EglPlatform {
 };
 // "auto", "device" or "surfaceless"; throws std::invalid_argument otherwise.
 EglPlatform parseEglPlatform(const std::string& name);
+
+// Where the calling thread's time went in the last renderSequence (milliseconds, summed over its frames).
+// Reported by the benchmark; wall-clock, never decides anything.
+struct SequenceTiming {
+  std::size_t frames = 0;
+  double submit_ms = 0.0;   // drawing and starting the asynchronous readback
+  double wait_ms = 0.0;     // waiting for a frame's readback to finish
+  double copy_ms = 0.0;     // mapping the pixel buffer and copying the frame out
+  double consume_ms = 0.0;  // in consume
+};
 
 struct RendererOptions {
   EglPlatform platform = EglPlatform::kAuto;
@@ -55,6 +67,15 @@ class EglRenderer {
   // frame. Without a mesh every pixel has no surface.
   void render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame);
 
+  // Renders a whole sequence of poses, pipelined: a few frames are queued on the GPU, each read back
+  // asynchronously into a pixel buffer object, while consume(k, frame) handles frame k on the calling thread,
+  // in order k = 0, 1, ... Each frame is what render() gives for the same pose. consume may take the frame's
+  // pixels (swap them out); it must not call the renderer. For datasets and benchmarks, where the poses are
+  // known ahead: a closed loop's next pose depends on this frame, so it renders one at a time.
+  void renderSequence(const std::vector<Eigen::Isometry3d>& T_lidar_target,
+                      const std::function<void(std::size_t, RenderedFrame&)>& consume);
+
+  const SequenceTiming& lastSequenceTiming() const;
   const std::string& glRenderer() const;        // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   const std::string& eglPlatform() const;       // "device" or "surfaceless"
   std::size_t trianglesDrawnLastFrame() const;  // after chunk culling, before back-face culling

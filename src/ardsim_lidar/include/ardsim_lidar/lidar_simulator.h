@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -32,6 +34,13 @@ class LidarSimulator {
   // One frame with T_lidar_target (target coordinates -> lidar_optical). frame_index seeds the frame's noise.
   void simulate(const Eigen::Isometry3d& T_lidar_target, std::uint64_t frame_index, LidarFrame* frame);
 
+  // Frames for a sequence of poses known ahead (datasets, benchmarks), pipelined: the renderer keeps frames
+  // queued on the GPU (EglRenderer::renderSequence) while the noise of earlier frames is applied in parallel
+  // tasks. Frame k is seeded with first_frame_index + k and equals simulate()'s. consume(k, frame) is called
+  // once per frame, from several threads at once and in no particular order. lastTiming() is not updated.
+  void simulateSequence(const std::vector<Eigen::Isometry3d>& T_lidar_target, std::uint64_t first_frame_index,
+                        const std::function<void(std::size_t, const LidarFrame&)>& consume);
+
   const SensorOptions& sensor() const { return sensor_; }
   const PixelRays& rays() const { return rays_; }
   const EglRenderer& renderer() const { return renderer_; }
@@ -47,6 +56,11 @@ class LidarSimulator {
   std::vector<ardsim_description::Material> materials_;
   RenderedFrame rendered_;
   FrameTiming timing_;
+  struct SequenceSlot {  // a frame in simulateSequence's noise stage
+    RenderedFrame rendered;
+    LidarFrame frame;
+  };
+  std::vector<SequenceSlot> sequence_slots_;
 };
 
 // Organized W x H cloud in lidar_optical: point = range * unit ray of its pixel; NaN x, y, z, intensity = no

@@ -33,6 +33,11 @@ struct IcpOptions {
   // from the offsets to the nearest model points across their normals beyond the model's sample spacing
   // (points past a rim or an edge), or is held where there are none. 0: point-to-plane only.
   double weak_direction_condition = 0.01;
+  // The offsets stop moving the pose anywhere inside the sampling (they count only beyond it): an estimate
+  // with weak directions that moved further from its prediction than this many pixel footprints (at the
+  // target's range) has likely stopped short of the truth: DEGRADED. Within it, the frame-to-frame wander of
+  // a tracked pose inside the sampling.
+  double degraded_weak_slide_px = 1.0;
   double min_sigma_m = 0.01;              // floor of the robust sigma (the sensor's range noise)
   double converged_translation_m = 1e-4;  // an update smaller than both ends the iterations
   double converged_rotation_rad = 1e-5;
