@@ -23,9 +23,6 @@ constexpr int kSearchStride = 3;
 // filling the view at 10 m) take most iterations: they run at a third of the cost.
 constexpr int kCoarseStride = 3;
 constexpr double kCoarseFactor = 10.0;
-// Correspondences are searched from the last iteration's (ReferenceModel::nearestVisibleFrom) when no scan
-// point moved more than this since: well under the model's finest sample spacing.
-constexpr double kWalkMaxMotionM = 0.005;
 constexpr int kFineIterations = 3;
 
 void require(bool ok, const std::string& name, double value, const std::string& allowed) {
@@ -327,7 +324,6 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
   const auto selectActive = [&](int every) {
     active_.clear();
     for (std::size_t k = 0; k < scan_.size(); k += every) active_.push_back(scan_[k]);
-    active_match_.assign(active_.size(), -1);
   };
   // Coarse first only where a third of the points is still plenty and the limit leaves room for it.
   bool coarse = stride == 1 && max_iterations > kFineIterations &&
@@ -348,20 +344,13 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     correspondences_.clear();
     const float gate_sq = static_cast<float>(gate * gate);
     std::size_t kept = 0;
-    for (std::size_t k = 0; k < active_.size(); ++k) {
-      const Eigen::Vector3f s = active_[k];
+    for (const Eigen::Vector3f& s : active_) {
       float distance_sq = 0.0f;
-      // From the last iteration's match: the pose moved little since.
-      const int j =
-          model_->nearestVisibleFrom(active_match_[k], T_target_lidar * s, gate_sq, visible_, &distance_sq);
-      active_match_[k] = j;
+      const int j = model_->nearestVisible(T_target_lidar * s, gate_sq, visible_, &distance_sq);
       if (j < 0) continue;
       // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
       // solar arrays, background returns. Searching for it again each iteration is the costliest query.
-      if (prune_unmatched) {
-        active_match_[kept] = j;
-        active_[kept++] = s;
-      }
+      if (prune_unmatched) active_[kept++] = s;
       Correspondence c;
       c.scan = s.cast<double>();
       c.model = T * model_->points()[j].cast<double>();
@@ -371,10 +360,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       c.spacing = model_->spacing()[j];
       correspondences_.push_back(c);
     }
-    if (prune_unmatched) {
-      active_.resize(kept);
-      active_match_.resize(kept);
-    }
+    if (prune_unmatched) active_.resize(kept);
     if (static_cast<int>(correspondences_.size()) < options_.min_points) {
       a.failure = "too few correspondences with the model: " + std::to_string(correspondences_.size()) +
                   " < " + std::to_string(options_.min_points);
@@ -442,12 +428,6 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     if (w.norm() > 0.0) step.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
     step.translation() = a.centre + v - step.linear() * a.centre;
     T = step * T;
-    // The next search starts from these matches only after a small step: a long one can carry a point past
-    // a gap in the model's neighbour graph (a petal to the ring), where the walk would stop short.
-    double lever_m = 0.0;
-    for (const Correspondence& c : correspondences_) lever_m = std::max(lever_m, (c.model - a.centre).norm());
-    if (v.norm() + w.norm() * lever_m > kWalkMaxMotionM)
-      std::fill(active_match_.begin(), active_match_.end(), -1);
     if (coarse) {
       if ((v.norm() < kCoarseFactor * options_.converged_translation_m &&
            w.norm() < kCoarseFactor * options_.converged_rotation_rad) ||

@@ -1,7 +1,6 @@
 #include "ardsim_pose/reference_model.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -188,19 +187,6 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
     chunks_.push_back(chunk);
   }
   tree_ = std::make_unique<KdTree>(&points_);
-  neighbours_.resize(points_.size() * kNeighbours);
-  std::array<std::uint32_t, kNeighbours + 1> found{};
-  std::array<float, kNeighbours + 1> found_distance_sq{};
-  for (std::size_t i = 0; i < points_.size(); ++i) {
-    const std::size_t count =
-        tree_->index.knnSearch(points_[i].data(), kNeighbours + 1, found.data(), found_distance_sq.data());
-    std::size_t written = 0;
-    for (std::size_t k = 0; k < count && written < kNeighbours; ++k)
-      if (found[k] != i) neighbours_[i * kNeighbours + written++] = found[k];
-    // Fewer model points than neighbours (tiny models): repeat the point itself, a no-op in the walk.
-    for (; written < kNeighbours; ++written)
-      neighbours_[i * kNeighbours + written] = static_cast<std::uint32_t>(i);
-  }
 }
 
 ReferenceModel::~ReferenceModel() = default;
@@ -211,33 +197,6 @@ int ReferenceModel::nearestVisible(const Eigen::Vector3f& query, float max_dista
   tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
   *distance_sq = result.best_distance_sq;
   return static_cast<int>(result.best_index);
-}
-
-int ReferenceModel::nearestVisibleFrom(int start, const Eigen::Vector3f& query, float max_distance_sq,
-                                       const std::vector<std::uint8_t>& visible, float* distance_sq) const {
-  if (start < 0 || !visible[start]) return nearestVisible(query, max_distance_sq, visible, distance_sq);
-  std::uint32_t best = static_cast<std::uint32_t>(start);
-  float best_distance_sq = (points_[best] - query).squaredNorm();
-  // Each step strictly nearer, so the walk ends; the bound only caps a long walk (then the tree is cheaper).
-  constexpr int kMaxSteps = 16;
-  int step = 0;
-  for (; step < kMaxSteps; ++step) {
-    const std::uint32_t from = best;
-    for (int k = 0; k < kNeighbours; ++k) {
-      const std::uint32_t n = neighbours_[from * kNeighbours + k];
-      if (!visible[n]) continue;
-      const float d = (points_[n] - query).squaredNorm();
-      if (d < best_distance_sq) {
-        best_distance_sq = d;
-        best = n;
-      }
-    }
-    if (best == from) break;
-  }
-  if (step == kMaxSteps || best_distance_sq > max_distance_sq)
-    return nearestVisible(query, max_distance_sq, visible, distance_sq);
-  *distance_sq = best_distance_sq;
-  return static_cast<int>(best);
 }
 
 VisibilityPredictor::VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics,

@@ -3,7 +3,6 @@
 // solar arrays turned away from the model, and filling the view at 250 m; LOST (not a wrong pose) on an empty
 // frame, a garbage frame and a frame of another object.
 #include <algorithm>
-#include <cstdio>
 #include <memory>
 #include <random>
 
@@ -124,56 +123,6 @@ TEST_F(RenderedIcp, SolarArraysTurnedFromTheModelDoNotMatter) {
       EXPECT_LT(e.attitude_error_angle_rad * 180.0 / M_PI, d > 50 ? 0.1 : 0.05) << d << " m";
     }
   }
-}
-
-// The warm-started search (a walk over the model's neighbour graph from the last iteration's match) must find
-// what the tree finds when the query moved a little since: queries a few mm off the visible model points,
-// started from the match of a query 5 mm away, with the visibility predicted from 30 and 10 m.
-TEST_F(RenderedIcp, NearestFromALastMatchEqualsTheTreeSearch) {
-  const ReferenceModel& model = *iss_model_;
-  VisibilityPredictor predictor(ardsim_lidar::intrinsicsFor(ardsim_lidar::SensorOptions{}),
-                                VisibilityOptions{});
-  std::mt19937_64 rng(11);
-  std::normal_distribution<float> offset(0.0f, 0.003f);
-  for (const double range_m : {30.0, 10.0}) {
-    std::vector<std::uint8_t> visible;
-    predictor.predict(model, dockingAxisPose(TargetKind::kIss, range_m), &visible);
-    int compared = 0;
-    int nearest = 0;  // as near as the tree's answer (float rounding aside: ties between samples)
-    float worst_excess_m = 0.0f;
-    for (std::size_t i = 0; i < model.size(); i += 7) {
-      if (!visible[i]) continue;
-      const Eigen::Vector3f query =
-          model.points()[i] + Eigen::Vector3f(offset(rng), offset(rng), offset(rng));
-      float tree_sq = 0.0f;
-      ASSERT_GE(model.nearestVisible(query, 0.25f, visible, &tree_sq), 0);
-      float start_sq = 0.0f;
-      const int start =
-          model.nearestVisible(query + Eigen::Vector3f(0.003f, -0.003f, 0.003f), 0.25f, visible, &start_sq);
-      float walk_sq = 0.0f;
-      const int from_walk = model.nearestVisibleFrom(start, query, 0.25f, visible, &walk_sq);
-      ASSERT_GE(from_walk, 0);
-      EXPECT_TRUE(visible[from_walk]);
-      const float excess_m = std::sqrt(walk_sq) - std::sqrt(tree_sq);
-      ++compared;
-      if (excess_m <= 1e-6f) ++nearest;
-      worst_excess_m = std::max(worst_excess_m, excess_m);
-    }
-    EXPECT_GT(compared, 500);
-    EXPECT_GE(nearest, 0.995 * compared) << range_m << " m";
-    EXPECT_LT(worst_excess_m, 0.01f) << range_m << " m";
-    std::printf(
-        "%.0f m: the walk found the nearest visible point for %d of %d queries, worst %.4f m farther\n",
-        range_m, nearest, compared, worst_excess_m);
-  }
-  // An invisible or missing start falls back to the tree.
-  std::vector<std::uint8_t> visible(model.size(), 1);
-  visible[0] = 0;
-  float a_sq = 0.0f, b_sq = 0.0f;
-  EXPECT_EQ(model.nearestVisibleFrom(-1, model.points()[1], 0.25f, visible, &a_sq),
-            model.nearestVisible(model.points()[1], 0.25f, visible, &b_sq));
-  EXPECT_EQ(model.nearestVisibleFrom(0, model.points()[1], 0.25f, visible, &a_sq),
-            model.nearestVisible(model.points()[1], 0.25f, visible, &b_sq));
 }
 
 class LostFrames : public RenderedIcp {

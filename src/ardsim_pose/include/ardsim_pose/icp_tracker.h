@@ -164,7 +164,6 @@ class IcpTracker : public PoseMethod {
   bool visibility_valid_ = false;
   std::vector<Eigen::Vector3f> scan_;
   std::vector<Eigen::Vector3f> active_;  // scan points still searched for
-  std::vector<int> active_match_;        // per active point, its model match in the last iteration (-1: none)
   std::vector<int> valid_;
   std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows

@@ -46,13 +46,6 @@ class ReferenceModel {
   // Nearest point with visible[index] != 0 within sqrt(max_distance_sq) of query (target frame); -1 if none.
   int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
                      const std::vector<std::uint8_t>& visible, float* distance_sq) const;
-  // The same, searched from a point near the answer (the last ICP iteration's): a walk to ever nearer visible
-  // neighbours (each point's kNeighbours nearest model points) until none is nearer, then the tree only if
-  // the walk ends beyond max_distance or start is not visible. Exact where the samples are dense around
-  // the query; ~10x cheaper than the tree when the query moved a little since.
-  int nearestVisibleFrom(int start, const Eigen::Vector3f& query, float max_distance_sq,
-                         const std::vector<std::uint8_t>& visible, float* distance_sq) const;
-  static constexpr int kNeighbours = 8;
 
   // Samples of one triangle close together: one visibility decision for all (points [begin, end)).
   struct Patch {
@@ -80,7 +73,6 @@ class ReferenceModel {
   std::vector<Patch> patches_;
   std::vector<Chunk> chunks_;
   std::unique_ptr<KdTree> tree_;
-  std::vector<std::uint32_t> neighbours_;  // kNeighbours per point, nearest first
 };
 
 struct VisibilityOptions {
