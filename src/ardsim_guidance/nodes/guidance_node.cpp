@@ -136,6 +136,16 @@ class GuidanceNode {
   }
 
   void onEstimate(const ardsim_msgs::PoseEstimate::ConstPtr& msg) {
+    // One answer per step. A repeat of a step already taken (a latched message delivered again as a
+    // connection is made, which the pose node answers by publishing its estimate again) would advance the
+    // guidance twice and change the command: the run would then depend on connection timing.
+    if (have_estimate_ && msg->header.stamp <= last_estimate_stamp_) {
+      ARDSIM_WARN_THROTTLE(5.0, "guidance: pose/estimate for t = %.3f s again (latest %.3f s): ignored",
+                           msg->header.stamp.toSec(), last_estimate_stamp_.toSec());
+      return;
+    }
+    have_estimate_ = true;
+    last_estimate_stamp_ = msg->header.stamp;
     pending_.push_back({msg, ros::WallTime::now()});
     flush(false);
   }
@@ -188,6 +198,8 @@ class GuidanceNode {
   ros::WallTimer timer_;
   std::map<ros::Time, OwnState> own_states_;
   ros::Time latest_odom_stamp_;
+  bool have_estimate_ = false;
+  ros::Time last_estimate_stamp_;
   std::deque<Pending> pending_;
   Phase last_phase_ = Phase::kWait;
   std::string last_reason_;

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Interface test of guidance_node: one command per estimate with the estimate's stamp; LOST -> hold command, then
+"""Interface test of guidance_node: one command per estimate with the estimate's stamp (a repeated estimate, as a
+latched message delivered twice, is not answered again); LOST -> hold command, then
 RETREAT after the limit; NaN / zero quaternions -> hold command and the node keeps running. No dynamics: the test
 publishes truth/chaser/odom (the chaser's own state) and pose/estimate itself, with consistent geometry (chaser
 port 20 m out on the ISS docking axis, docking attitude)."""
@@ -88,14 +89,17 @@ class GuidanceInterface(unittest.TestCase):
     def test_interface(self):
         stamps = []
         # Tracking, then malformed quaternions, then LOST for longer than the 3 s limit.
-        for _ in range(20):
+        for i in range(20):
             stamps.append(self.send())
+            if i in (0, 7):  # the same step again: no second command
+                self.est_pub.publish(estimate(stamps[-1]))
         stamps.append(self.send(q=(float("nan"), 0.0, 0.0, 0.0)))
         stamps.append(self.send(q=(0.0, 0.0, 0.0, 0.0)))
         for _ in range(40):
             stamps.append(self.send(status=PoseEstimate.STATUS_LOST))
             time.sleep(0.002)
         self.wait_for(len(stamps))
+        time.sleep(0.5)  # a second answer, if any, would have come by now
         with self.lock:
             commands, states = list(self.commands), list(self.states)
         # One command per estimate, same stamps, in order, frame "chaser".
