@@ -134,35 +134,14 @@ void BM_RenderIssSequence_Embree(benchmark::State& state) {
   state.counters["returns"] = static_cast<double>(returns.load());
 }
 
-// Wall time: llvmpipe and Embree both work on threads other than the benchmark's.
-BENCHMARK(BM_RenderIss_Ardsim)
-    ->Arg(100)
-    ->Arg(30)
-    ->Arg(10)
-    ->Arg(3)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(BM_RenderIss_Embree)
-    ->Arg(100)
-    ->Arg(30)
-    ->Arg(10)
-    ->Arg(3)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(BM_RenderIssSequence_Ardsim)
-    ->Arg(100)
-    ->Arg(30)
-    ->Arg(10)
-    ->Arg(3)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(BM_RenderIssSequence_Embree)
-    ->Arg(100)
-    ->Arg(30)
-    ->Arg(10)
-    ->Arg(3)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+// The docking-axis ranges. Wall time: llvmpipe and Embree both work on threads other than the benchmark's.
+void atRanges(benchmark::internal::Benchmark* b) {
+  b->Arg(100)->Arg(30)->Arg(10)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+BENCHMARK(BM_RenderIss_Ardsim)->Apply(atRanges);
+BENCHMARK(BM_RenderIss_Embree)->Apply(atRanges);
+BENCHMARK(BM_RenderIssSequence_Ardsim)->Apply(atRanges);
+BENCHMARK(BM_RenderIssSequence_Embree)->Apply(atRanges);
 
 }  // namespace
 }  // namespace ardsim_lidar

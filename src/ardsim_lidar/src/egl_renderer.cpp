@@ -548,10 +548,10 @@ void EglRenderer::renderSequence(const std::vector<Eigen::Isometry3d>& T_lidar_t
     }
   };
   RenderedFrame frame;
-  // Waits for frame k's readback, copies it out of its pixel buffer and hands it over.
   SequenceTiming& timing = impl.sequence_timing;
   timing = SequenceTiming{};
   timing.frames = T_lidar_target.size();
+  // Waits for frame k's readback, copies it out of its pixel buffer and hands it over.
   auto retrieve = [&](std::size_t k) {
     const std::size_t slot = k % kFramesInFlight;
     auto start = Clock::now();
