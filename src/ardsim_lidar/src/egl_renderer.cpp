@@ -256,13 +256,17 @@ struct EglRenderer::Impl {
     GLint minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
-    bool clip_control = major > 4 || (major == 4 && minor >= 5);
     GLint extension_count = 0;
     glGetIntegerv(GL_NUM_EXTENSIONS, &extension_count);
-    for (GLint i = 0; i < extension_count && !clip_control; ++i)
-      clip_control = std::strcmp(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i)),
-                                 "GL_ARB_clip_control") == 0;
-    if (!clip_control)
+    // In core OpenGL from version.minor on, or as the extension.
+    auto supports = [&](GLint need_major, GLint need_minor, const char* extension) {
+      if (major > need_major || (major == need_major && minor >= need_minor)) return true;
+      for (GLint i = 0; i < extension_count; ++i)
+        if (std::strcmp(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i)), extension) == 0)
+          return true;
+      return false;
+    };
+    if (!supports(4, 5, "GL_ARB_clip_control"))
       throw std::runtime_error("OpenGL: " + gl_renderer +
                                " lacks glClipControl (GL 4.5 or GL_ARB_clip_control)");
 
@@ -319,10 +323,7 @@ struct EglRenderer::Impl {
 
     // Pixel buffers for renderSequence. With buffer storage (OpenGL 4.4) they are mapped once, persistently,
     // in client memory: mapping a buffer per frame cost NVIDIA's driver ~0.3 ms per 1 MB frame (page faults).
-    bool buffer_storage = major > 4 || (major == 4 && minor >= 4);
-    for (GLint i = 0; i < extension_count && !buffer_storage; ++i)
-      buffer_storage = std::strcmp(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, i)),
-                                   "GL_ARB_buffer_storage") == 0;
+    const bool buffer_storage = supports(4, 4, "GL_ARB_buffer_storage");
     glGenBuffers(static_cast<GLsizei>(pixel_buffers.size()), pixel_buffers.data());
     for (std::size_t slot = 0; slot < pixel_buffers.size(); ++slot) {
       const GLsizeiptr bytes = static_cast<GLsizeiptr>(frameBytes());
@@ -336,7 +337,7 @@ struct EglRenderer::Impl {
       }
     }
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    if (glGetError() != GL_NO_ERROR) throw std::runtime_error("OpenGL: creating the pixel buffers failed");
+    checkErrors("creating the pixel buffers");
   }
 
   std::size_t pixelCount() const { return static_cast<std::size_t>(sensor.width) * sensor.height; }

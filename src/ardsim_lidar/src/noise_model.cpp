@@ -241,8 +241,8 @@ void NoiseModel::apply(const RenderedFrame& rendered,
   // Blooming: light from a saturated retro-reflector spills into neighbours that have a weaker (or no)
   // return.
   const int radius = options_.bloom_radius_px;
-  std::vector<int>
-      bloom_sources;  // in row order: where spills overlap, the result does not depend on threads
+  // In row order: where spills overlap, the result does not depend on threads.
+  std::vector<int> bloom_sources;
   for (const auto& block : saturated_retro_pixels)
     bloom_sources.insert(bloom_sources.end(), block.begin(), block.end());
   for (const int source : bloom_sources) {

@@ -647,11 +647,14 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   result.boresight_rotation_observed = boresightObserved(H_scaled, largest);
   // With the boresight rotation unobserved (held at its prediction, flagged), the pose is still good when
   // the other five are well constrained: judge the condition of those five.
-  double condition_of_the_rest = condition;
-  if (!result.boresight_rotation_observed && largest > 0.0) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> rest(H_scaled.topLeftCorner<5, 5>());
-    condition_of_the_rest = rest.eigenvalues()(0) / largest;
-  }
+  // The weakest of the five unknowns besides the boresight rotation, relative to the largest: also what
+  // says whether the weak-direction step was taken (weak_direction_condition).
+  const double condition_of_five = largest > 0.0 ? Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>(
+                                                       H_scaled.topLeftCorner<5, 5>(), Eigen::EigenvaluesOnly)
+                                                           .eigenvalues()(0) /
+                                                       largest
+                                                 : 0.0;
+  const double condition_of_the_rest = result.boresight_rotation_observed ? condition : condition_of_five;
 
   coverage_ = coverage();
   const double correction_m = (T.translation() - T_predicted.translation()).norm();
@@ -684,11 +687,9 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     degraded.push_back(format("fit rms %.3f m", result.fit_rms_m));
   if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
   const double footprint_m = T.translation().norm() / std::min(intrinsics_.fx, intrinsics_.fy);
-  if (options_.weak_direction_condition > 0.0 &&
+  if (options_.weak_direction_condition > 0.0 && largest > 0.0 &&
       correction_m > options_.degraded_weak_slide_px * footprint_m &&
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>(H_scaled.topLeftCorner<5, 5>(),
-                                                                 Eigen::EigenvaluesOnly)
-              .eigenvalues()(0) < options_.weak_direction_condition * largest)
+      condition_of_five < options_.weak_direction_condition)
     degraded.push_back(format("weakly observed directions: %.3f m from the prediction > %.3f m", correction_m,
                               options_.degraded_weak_slide_px * footprint_m));
   if (condition_of_the_rest < options_.degraded_condition)
