@@ -64,7 +64,7 @@ void EmbreeRayCaster::cast(const Eigen::Isometry3d& T_lidar_target, RenderedFram
   const int height = impl.sensor.height;
   frame->width = width;
   frame->height = height;
-  frame->pixels.assign(static_cast<std::size_t>(width) * height, SurfaceSample{0.0f, 0.0f, -1.0f, 0.0f});
+  frame->pixels.assign(static_cast<std::size_t>(width) * height, SurfaceSample{});
   const Eigen::Isometry3d T_target_lidar = T_lidar_target.inverse();
   const Eigen::Vector3f origin = T_target_lidar.translation().cast<float>();
   const Eigen::Matrix3f R_target_lidar = T_target_lidar.linear().cast<float>();

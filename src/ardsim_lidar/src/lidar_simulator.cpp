@@ -55,7 +55,7 @@ void LidarSimulator::simulateSequence(const std::vector<Eigen::Isometry3d>& T_li
   for (std::size_t s = 0; s < slot_count; ++s) free_slots.push(s);
   tbb::task_group tasks;
   try {
-    renderer_.renderSequence(T_lidar_target, [&](std::size_t k, RenderedFrame& rendered) {
+    renderer_.renderSequence(T_lidar_target, [&](std::size_t k, TriangleIdFrame& ids) {
       std::size_t s = 0;
       // Without worker threads the tasks run only inside wait(): never block on the queue then.
       while (!free_slots.try_pop(s)) {
@@ -65,13 +65,14 @@ void LidarSimulator::simulateSequence(const std::vector<Eigen::Isometry3d>& T_li
         }
         tasks.wait();
       }
-      std::swap(slots[s].rendered, rendered);
-      tasks.run([this, &slots, &free_slots, &consume, s, k, first_frame_index] {
+      std::swap(slots[s].ids, ids);
+      tasks.run([this, &slots, &free_slots, &consume, &T_lidar_target, s, k, first_frame_index] {
         struct Release {
           tbb::concurrent_bounded_queue<std::size_t>& queue;
           std::size_t slot;
           ~Release() { queue.push(slot); }
         } release{free_slots, s};
+        renderer_.resolve(slots[s].ids, T_lidar_target[k], &slots[s].rendered);
         noise_model_.apply(slots[s].rendered, materials_, first_frame_index + k, &slots[s].frame);
         consume(k, slots[s].frame);
       });

@@ -33,9 +33,10 @@ TEST(Sequence, RenderedFramesEqualSingleRendersInOrder) {
     const std::vector<Eigen::Isometry3d> poses = approach(count);
     std::vector<std::size_t> order;
     std::vector<RenderedFrame> frames;
-    renderer.renderSequence(poses, [&](std::size_t k, RenderedFrame& frame) {
+    renderer.renderSequence(poses, [&](std::size_t k, TriangleIdFrame& ids) {
       order.push_back(k);
-      frames.push_back(frame);
+      frames.emplace_back();
+      renderer.resolve(ids, poses[k], &frames.back());
     });
     ASSERT_EQ(order.size(), count);
     for (std::size_t k = 0; k < count; ++k) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -35,6 +36,15 @@ struct SequenceTiming {
   double consume_ms = 0.0;  // in consume
 };
 
+// What the renderer reads back: per pixel, the nearest triangle along the pixel's ray as its id (1 + its index
+// in the renderer's drawing order; 0: no surface within the render volume). EglRenderer::resolve turns it into
+// a RenderedFrame.
+struct TriangleIdFrame {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint32_t> triangle_id;  // row-major, row 0 at the top of the image (y down)
+};
+
 struct RendererOptions {
   EglPlatform platform = EglPlatform::kAuto;
   // Triangles are grouped into spatially compact chunks; chunks whose bounding sphere lies outside the view
@@ -43,10 +53,10 @@ struct RendererOptions {
 };
 
 // Renders into a framebuffer object: a GL_DEPTH_COMPONENT32F depth buffer with reversed Z (uniform relative
-// depth precision from the near plane to 5 km) for visibility, and an RGBA32F colour target holding, per
-// pixel, the range along the pixel's ray, the cosine of incidence and the material index (SurfaceSample).
-// Range comes from the interpolated lidar-frame position, so it is exact at the pixel centre (no depth-buffer
-// quantisation).
+// depth precision from the near plane to 5 km) for visibility, and an R32UI colour target holding, per pixel,
+// the id of the nearest triangle (a visibility buffer). resolve() then intersects each pixel's ray with its
+// triangle's plane on the CPU: the range along the ray (exact at the pixel centre, no depth-buffer
+// quantisation), the cosine of incidence and the material index (SurfaceSample).
 //
 // Thread-safe: each call makes the context current on the calling thread and releases it again, so a
 // nodelet's callbacks may run on any thread.
@@ -63,17 +73,24 @@ class EglRenderer {
   // mesh.
   void setMesh(const ardsim_description::TriangleMesh& mesh);
 
-  // Renders the mesh with T_lidar_target (target coordinates -> lidar_optical coordinates) and reads back the
-  // frame. Without a mesh every pixel has no surface.
+  // Renders the mesh with T_lidar_target (target coordinates -> lidar_optical coordinates), reads back the
+  // frame and resolves it. Without a mesh every pixel has no surface.
   void render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame);
 
   // Renders a whole sequence of poses, pipelined: a few frames are queued on the GPU, each read back
-  // asynchronously into a pixel buffer object, while consume(k, frame) handles frame k on the calling thread,
-  // in order k = 0, 1, ... Each frame is what render() gives for the same pose. consume may take the frame's
-  // pixels (swap them out); it must not call the renderer. For datasets and benchmarks, where the poses are
-  // known ahead: a closed loop's next pose depends on this frame, so it renders one at a time.
+  // asynchronously into a pixel buffer object, while consume(k, ids) handles frame k on the calling thread, in
+  // order k = 0, 1, ... resolve(ids, T_lidar_target[k]) gives what render() gives for the same pose; it is
+  // left to the caller so that it runs where the caller's other per-frame work runs (in parallel), not on the
+  // rendering thread. consume may take the ids (swap them out); it must not call the renderer's other
+  // members. For datasets and benchmarks, where the poses are known ahead: a closed loop's next pose depends on
+  // this frame, so it renders one at a time.
   void renderSequence(const std::vector<Eigen::Isometry3d>& T_lidar_target,
-                      const std::function<void(std::size_t, RenderedFrame&)>& consume);
+                      const std::function<void(std::size_t, TriangleIdFrame&)>& consume);
+
+  // The surface at each pixel of a frame rendered with T_lidar_target. No OpenGL: safe from any number of
+  // threads at once, also during renderSequence (not during setMesh). Throws std::invalid_argument for a
+  // frame of another size.
+  void resolve(const TriangleIdFrame& ids, const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame) const;
 
   const SequenceTiming& lastSequenceTiming() const;
   const std::string& glRenderer() const;        // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"

@@ -18,7 +18,7 @@
 namespace ardsim_lidar {
 
 struct FrameTiming {
-  double render_ms = 0.0;  // draw and readback
+  double render_ms = 0.0;  // draw, readback and resolving the triangle ids
   double noise_ms = 0.0;   // noise model
 };
 
@@ -57,6 +57,7 @@ class LidarSimulator {
   RenderedFrame rendered_;
   FrameTiming timing_;
   struct SequenceSlot {  // a frame in simulateSequence's noise stage
+    TriangleIdFrame ids;
     RenderedFrame rendered;
     LidarFrame frame;
   };

@@ -6,14 +6,12 @@
 
 namespace ardsim_lidar {
 
-// One pixel as read back from the renderer's RGBA32F colour target (so the readback is a single memcpy).
+// The surface seen by one pixel.
 struct SurfaceSample {
   float range_m = 0.0f;        // along the pixel's unit ray; 0 = no surface within the render volume
   float cos_incidence = 0.0f;  // |cos| of the angle between the ray and the triangle's normal
   float material = -1.0f;      // index into TriangleMesh::materials; < 0 where there is no surface
-  float unused = 0.0f;
 };
-static_assert(sizeof(SurfaceSample) == 4 * sizeof(float), "SurfaceSample must match the RGBA32F texel");
 
 struct RenderedFrame {
   int width = 0;
