@@ -535,33 +535,40 @@ void EglRenderer::resolve(const TriangleIdFrame& ids, const Eigen::Isometry3d& T
   frame->width = ids.width;
   frame->height = ids.height;
   frame->pixels.resize(impl.pixelCount());
-  // The pixel's ray and the sensor's origin in the target frame, where the planes are.
-  const Eigen::Isometry3d T_target_lidar = T_lidar_target.inverse();
-  const Eigen::Matrix3f R_target_lidar = T_target_lidar.linear().cast<float>();
-  const Eigen::Vector3f origin_target = T_target_lidar.translation().cast<float>();
+  // The planes in the lidar frame (n . x = d there too): a few microseconds, and then each pixel needs only
+  // its dot product with the ray.
   const std::size_t triangle_count = impl.triangle_planes.size();
+  std::vector<Eigen::Vector4f> planes_lidar(triangle_count);
+  // (n, d) -> (R n, d + (R n) . t) as one 4 x 4 product.
+  Eigen::Matrix4d plane_map = Eigen::Matrix4d::Zero();
+  plane_map.topLeftCorner<3, 3>() = T_lidar_target.linear();
+  plane_map.bottomLeftCorner<1, 3>() = T_lidar_target.translation().transpose() * T_lidar_target.linear();
+  plane_map(3, 3) = 1.0;
+  const Eigen::Matrix4f plane_map_f = plane_map.cast<float>();
+  for (std::size_t k = 0; k < triangle_count; ++k) planes_lidar[k] = plane_map_f * impl.triangle_planes[k];
+  const float near_m = static_cast<float>(impl.sensor.near_plane_m);
+  const float far_m = static_cast<float>(impl.far_plane_m);
   const int width = ids.width;
   tbb::parallel_for(tbb::blocked_range<int>(0, ids.height, 16), [&](const tbb::blocked_range<int>& rows) {
-    for (int v = rows.begin(); v < rows.end(); ++v) {
-      for (int i = v * width; i < (v + 1) * width; ++i) {
-        SurfaceSample& sample = frame->pixels[i];
-        const std::uint32_t id = ids.triangle_id[i];
-        if (id == 0 || id > triangle_count) {
-          sample = SurfaceSample{};
-          continue;
-        }
-        const Eigen::Vector4f& plane = impl.triangle_planes[id - 1];
-        const Eigen::Vector3f& ray_lidar = impl.rays.ray(i);
-        const float along = plane.head<3>().dot(R_target_lidar * ray_lidar);
-        // The rasteriser drew only front faces whose plane the pixel's centre ray crosses; the clamp to the
-        // render volume only guards the rounding of a plane seen nearly edge-on.
-        const float range = (plane.w() - plane.head<3>().dot(origin_target)) / along;
-        const float lower = impl.sensor.near_plane_m / ray_lidar.z();
-        const float upper = impl.far_plane_m / ray_lidar.z();
-        sample.range_m = std::isfinite(range) ? std::clamp(range, lower, upper) : upper;
-        sample.cos_incidence = std::abs(along);
-        sample.material = impl.triangle_materials[id - 1];
+    for (int i = rows.begin() * width; i < rows.end() * width; ++i) {
+      SurfaceSample& sample = frame->pixels[i];
+      const std::uint32_t id = ids.triangle_id[i];
+      if (id == 0 || id > triangle_count) {
+        sample = SurfaceSample{};
+        continue;
       }
+      const Eigen::Vector4f& plane = planes_lidar[id - 1];
+      const Eigen::Vector3f& ray = impl.rays.ray(i);
+      const float along = plane.head<3>().dot(ray);
+      float range = plane.w() / along;
+      // The rasteriser drew only front faces whose plane the pixel's centre ray crosses, between the near and
+      // the far plane; this only guards the rounding of a plane seen nearly edge-on.
+      const float z = range * ray.z();
+      if (!(z >= near_m)) range = near_m / ray.z();
+      if (!(z <= far_m)) range = far_m / ray.z();
+      sample.range_m = range;
+      sample.cos_incidence = std::abs(along);
+      sample.material = impl.triangle_materials[id - 1];
     }
   });
 }

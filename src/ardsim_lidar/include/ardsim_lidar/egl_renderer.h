@@ -36,9 +36,9 @@ struct SequenceTiming {
   double consume_ms = 0.0;  // in consume
 };
 
-// What the renderer reads back: per pixel, the nearest triangle along the pixel's ray as its id (1 + its index
-// in the renderer's drawing order; 0: no surface within the render volume). EglRenderer::resolve turns it into
-// a RenderedFrame.
+// What the renderer reads back: per pixel, the nearest triangle along the pixel's ray as its id (1 + its
+// index in the renderer's drawing order; 0: no surface within the render volume). EglRenderer::resolve turns
+// it into a RenderedFrame.
 struct TriangleIdFrame {
   int width = 0;
   int height = 0;
@@ -78,19 +78,20 @@ class EglRenderer {
   void render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame);
 
   // Renders a whole sequence of poses, pipelined: a few frames are queued on the GPU, each read back
-  // asynchronously into a pixel buffer object, while consume(k, ids) handles frame k on the calling thread, in
-  // order k = 0, 1, ... resolve(ids, T_lidar_target[k]) gives what render() gives for the same pose; it is
+  // asynchronously into a pixel buffer object, while consume(k, ids) handles frame k on the calling thread,
+  // in order k = 0, 1, ... resolve(ids, T_lidar_target[k]) gives what render() gives for the same pose; it is
   // left to the caller so that it runs where the caller's other per-frame work runs (in parallel), not on the
   // rendering thread. consume may take the ids (swap them out); it must not call the renderer's other
-  // members. For datasets and benchmarks, where the poses are known ahead: a closed loop's next pose depends on
-  // this frame, so it renders one at a time.
+  // members. For datasets and benchmarks, where the poses are known ahead: a closed loop's next pose depends
+  // on this frame, so it renders one at a time.
   void renderSequence(const std::vector<Eigen::Isometry3d>& T_lidar_target,
                       const std::function<void(std::size_t, TriangleIdFrame&)>& consume);
 
   // The surface at each pixel of a frame rendered with T_lidar_target. No OpenGL: safe from any number of
   // threads at once, also during renderSequence (not during setMesh). Throws std::invalid_argument for a
   // frame of another size.
-  void resolve(const TriangleIdFrame& ids, const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame) const;
+  void resolve(const TriangleIdFrame& ids, const Eigen::Isometry3d& T_lidar_target,
+               RenderedFrame* frame) const;
 
   const SequenceTiming& lastSequenceTiming() const;
   const std::string& glRenderer() const;        // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
