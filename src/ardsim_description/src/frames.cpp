@@ -56,4 +56,14 @@ Eigen::Isometry3d T_chaser_lidar() {
   return T;
 }
 
+Eigen::Isometry3d lidarFromTarget(const Eigen::Isometry3d& T_eci_target,
+                                  const Eigen::Isometry3d& T_eci_chaser,
+                                  const Eigen::Isometry3d& T_chaser_lidar) {
+  const Eigen::Matrix3d R_chaser_eci = T_eci_chaser.linear().transpose();
+  Eigen::Isometry3d T_chaser_target = Eigen::Isometry3d::Identity();
+  T_chaser_target.linear() = R_chaser_eci * T_eci_target.linear();
+  T_chaser_target.translation() = R_chaser_eci * (T_eci_target.translation() - T_eci_chaser.translation());
+  return T_chaser_lidar.inverse() * T_chaser_target;
+}
+
 }  // namespace ardsim_description

@@ -21,12 +21,6 @@ namespace ardsim_lidar {
 bool bodyPoseFromOdometry(const nav_msgs::Odometry& odometry, Eigen::Isometry3d* T_eci_body,
                           std::string* error);
 
-// T_lidar_target = T_chaser_lidar^-1 * T_eci_chaser^-1 * T_eci_target, with the eci positions (about 7e6 m)
-// subtracted before anything else so that no precision is lost.
-Eigen::Isometry3d lidarFromTarget(const Eigen::Isometry3d& T_eci_target,
-                                  const Eigen::Isometry3d& T_eci_chaser,
-                                  const Eigen::Isometry3d& T_chaser_lidar);
-
 // Organized width x height cloud, fields x y z intensity (float32), NaN where there is no return.
 sensor_msgs::PointCloud2Ptr toPointCloud2(const LidarFrame& frame, const PixelRays& rays,
                                           const std_msgs::Header& header);

@@ -177,7 +177,8 @@ void LidarDriver::onTruth(const nav_msgs::OdometryConstPtr& target,
   const bool stale = options_.frame_rate_hz > 0.0 && have_frame_ &&
                      (stamp - last_frame_time_).toSec() < 1.0 / options_.frame_rate_hz - 1e-9;
   if (!stale) {
-    const Eigen::Isometry3d T_lidar_target = lidarFromTarget(T_eci_target, T_eci_chaser, T_chaser_lidar_);
+    const Eigen::Isometry3d T_lidar_target =
+        ardsim_description::lidarFromTarget(T_eci_target, T_eci_chaser, T_chaser_lidar_);
     // The stamp in nanoseconds selects the frame's noise: a frame is reproducible whatever ran before it.
     simulator_.simulate(T_lidar_target, stamp.toNSec(), &frame_);
     last_frame_time_ = stamp;

@@ -507,7 +507,7 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   impl_->chunks = std::move(chunks);
   impl_->triangle_planes = std::move(planes);
   impl_->triangle_materials = std::move(materials);
-  if (glGetError() != GL_NO_ERROR) throw std::runtime_error("OpenGL: uploading the mesh failed");
+  impl_->checkErrors("uploading the mesh");
 }
 
 void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame* frame) {

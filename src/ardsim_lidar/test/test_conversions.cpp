@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "../nodes/conversions.h"
+#include "ardsim_description/frames.h"
 
 namespace ardsim_lidar {
 namespace {
@@ -35,7 +36,8 @@ TEST(Conversions, RelativePoseKeepsMillimetresAtOrbitalDistances) {
   ASSERT_TRUE(bodyPoseFromOdometry(odometry(target_eci + offset_eci, q_chaser), &T_eci_chaser, &error));
   Eigen::Isometry3d T_chaser_lidar = Eigen::Isometry3d::Identity();
   T_chaser_lidar.translation() = Eigen::Vector3d(2.0, 0.0, 0.0);
-  const Eigen::Isometry3d T_lidar_target = lidarFromTarget(T_eci_target, T_eci_chaser, T_chaser_lidar);
+  const Eigen::Isometry3d T_lidar_target =
+      ardsim_description::lidarFromTarget(T_eci_target, T_eci_chaser, T_chaser_lidar);
   // Expected, built from the small relative quantities only.
   const Eigen::Vector3d expected_translation =
       q_chaser.conjugate() * (-offset_eci) - Eigen::Vector3d(2.0, 0.0, 0.0);

@@ -172,15 +172,6 @@ bool poseFromOdometry(const nav_msgs::Odometry& msg, Eigen::Isometry3d* T, std::
   return true;
 }
 
-Eigen::Isometry3d lidarFromTruth(const Eigen::Isometry3d& T_eci_target, const Eigen::Isometry3d& T_eci_chaser,
-                                 const Eigen::Isometry3d& T_chaser_lidar) {
-  Eigen::Isometry3d T_chaser_target = Eigen::Isometry3d::Identity();
-  T_chaser_target.linear() = T_eci_chaser.linear().transpose() * T_eci_target.linear();
-  T_chaser_target.translation() =
-      T_eci_chaser.linear().transpose() * (T_eci_target.translation() - T_eci_chaser.translation());
-  return T_chaser_lidar.inverse() * T_chaser_target;
-}
-
 ardsim_msgs::PoseErrorPtr toPoseError(const PoseErrorValue& e, const ardsim_msgs::PoseEstimate& estimate) {
   ardsim_msgs::PoseErrorPtr msg(new ardsim_msgs::PoseError);
   msg->header = estimate.header;

@@ -35,10 +35,6 @@ bool poseFromEstimate(const ardsim_msgs::PoseEstimate& msg, Eigen::Isometry3d* T
 // quaternion.
 bool poseFromOdometry(const nav_msgs::Odometry& msg, Eigen::Isometry3d* T_eci_body, std::string* error);
 
-// T_lidar_target from the truth odometries, the eci positions (about 7e6 m) subtracted first.
-Eigen::Isometry3d lidarFromTruth(const Eigen::Isometry3d& T_eci_target, const Eigen::Isometry3d& T_eci_chaser,
-                                 const Eigen::Isometry3d& T_chaser_lidar);
-
 ardsim_msgs::PoseErrorPtr toPoseError(const PoseErrorValue& error, const ardsim_msgs::PoseEstimate& estimate);
 
 }  // namespace ardsim_pose

@@ -67,7 +67,8 @@ class PoseEvaluator {
         !poseFromEstimate(*estimate->second, &T_estimate, &error)) {
       ARDSIM_WARN_THROTTLE(5.0, "pose_evaluator: cannot evaluate t = %.6f: %s", stamp.toSec(), error.c_str());
     } else {
-      const Eigen::Isometry3d truth = lidarFromTruth(T_eci_target, T_eci_chaser, T_chaser_lidar_);
+      const Eigen::Isometry3d truth =
+          ardsim_description::lidarFromTarget(T_eci_target, T_eci_chaser, T_chaser_lidar_);
       error_publisher_.publish(toPoseError(poseError(T_estimate, truth, T_target_port_), *estimate->second));
     }
     // This stamp is done; older ones will not be completed either.

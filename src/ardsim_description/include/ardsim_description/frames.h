@@ -30,4 +30,10 @@ Eigen::Isometry3d T_port_port_docked();
 // down.
 Eigen::Isometry3d T_chaser_lidar();
 
+// T_lidar_target = T_chaser_lidar^-1 * T_eci_chaser^-1 * T_eci_target from the vehicles' eci poses, with the
+// eci positions (about 7e6 m) subtracted before anything else so that no precision is lost.
+Eigen::Isometry3d lidarFromTarget(const Eigen::Isometry3d& T_eci_target,
+                                  const Eigen::Isometry3d& T_eci_chaser,
+                                  const Eigen::Isometry3d& T_chaser_lidar);
+
 }  // namespace ardsim_description
