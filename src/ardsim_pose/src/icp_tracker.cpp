@@ -211,6 +211,7 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
   // residuals; a twist moves e by -A (v, w), A = [P, -P [m - c]x]. Built only here: most ISS iterations have
   // no weak direction.
   const double pixel_pitch_rad = 1.0 / std::min(intrinsics_.fx, intrinsics_.fy);
+  const Eigen::Isometry3f T_target_lidar = a.T.inverse().cast<float>();
   Eigen::Matrix<double, 6, 6> H_tangential = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> g_tangential = Eigen::Matrix<double, 6, 1>::Zero();
   for (const Correspondence& c : correspondences_) {
@@ -221,6 +222,11 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
     const double e_norm = e.norm();
     const double sampling = std::max(c.spacing, c.scan.norm() * pixel_pitch_rad);
     if (e_norm <= sampling) continue;
+    // Where the visibility crop left out nearer samples of the model (a patch judged hidden), the offset to
+    // the nearest visible one is the crop's, not the pose's: only where the model really ends is it
+    // information. (A single ISS frame at 30 m slid 0.12 m on such offsets.)
+    const float sampling_sq = static_cast<float>(sampling * sampling);
+    if (model_->anyWithin(T_target_lidar * c.scan.cast<float>(), sampling_sq)) continue;
     Eigen::Matrix<double, 3, 6> A;
     A.leftCols<3>() = P;
     A.rightCols<3>() = -P * skew(c.model - a.centre);

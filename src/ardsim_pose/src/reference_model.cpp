@@ -199,6 +199,15 @@ int ReferenceModel::nearestVisible(const Eigen::Vector3f& query, float max_dista
   return static_cast<int>(result.best_index);
 }
 
+bool ReferenceModel::anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const {
+  std::uint32_t index = 0;
+  float distance_sq = 0.0f;
+  nanoflann::KNNResultSet<float, std::uint32_t> result(1);
+  result.init(&index, &distance_sq);
+  tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  return distance_sq <= max_distance_sq;
+}
+
 VisibilityPredictor::VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics,
                                          const VisibilityOptions& options)
     : intrinsics_(intrinsics), options_(options) {

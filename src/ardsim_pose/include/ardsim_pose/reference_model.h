@@ -46,6 +46,8 @@ class ReferenceModel {
   // Nearest point with visible[index] != 0 within sqrt(max_distance_sq) of query (target frame); -1 if none.
   int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
                      const std::vector<std::uint8_t>& visible, float* distance_sq) const;
+  // Whether any model point, visible or not, lies within sqrt(max_distance_sq) of query (target frame).
+  bool anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const;
 
   // Samples of one triangle close together: one visibility decision for all (points [begin, end)).
   struct Patch {
