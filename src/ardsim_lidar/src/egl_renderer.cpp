@@ -36,22 +36,25 @@ double millisecondsSince(Clock::time_point* start) {
 
 constexpr const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position_target;
+layout(location = 1) in uint triangle_id_in;
 uniform mat4 T_lidar_target;
 uniform mat4 projection;
+flat out uint triangle_id_vertex;
 void main() {
+  triangle_id_vertex = triangle_id_in;
   gl_Position = projection * (T_lidar_target * vec4(position_target, 1.0));
 }
 )";
 
 // A visibility buffer: each pixel keeps the id of the nearest triangle (the range and the incidence follow
-// exactly on the CPU from its plane and the pixel's ray). Cheaper than shading on llvmpipe (render 1.5-3.6 ->
-// 1.1-2.1 ms a frame) and a quarter of the readback. gl_PrimitiveID restarts at 0 with each draw call, so
-// first_triangle_id says where the draw starts.
+// exactly on the CPU from its plane and the pixel's ray). Cheaper than shading on llvmpipe (render 1.5-3.3 ->
+// 1.1-2.3 ms a frame) and a quarter of the readback. The id comes flat from each triangle's provoking (last)
+// vertex, which setMesh makes its own: gl_PrimitiveID cost llvmpipe another 0.2-0.3 ms a frame.
 constexpr const char* kFragmentShader = R"(#version 330 core
-uniform uint first_triangle_id;
+flat in uint triangle_id_vertex;
 layout(location = 0) out uint triangle_id;
 void main() {
-  triangle_id = first_triangle_id + uint(gl_PrimitiveID);
+  triangle_id = triangle_id_vertex;
 }
 )";
 
@@ -152,7 +155,6 @@ struct EglRenderer::Impl {
   std::array<const void*, kFramesInFlight> pixel_buffer_maps{};  // persistent mappings, or null
   GLint uniform_T_lidar_target = -1;
   GLint uniform_projection = -1;
-  GLint uniform_first_triangle_id = -1;
 
   PixelRays rays;
   std::vector<Chunk> chunks;
@@ -280,7 +282,6 @@ struct EglRenderer::Impl {
     if (linked != GL_TRUE) throw std::runtime_error("OpenGL: shader program failed to link");
     uniform_T_lidar_target = glGetUniformLocation(program, "T_lidar_target");
     uniform_projection = glGetUniformLocation(program, "projection");
-    uniform_first_triangle_id = glGetUniformLocation(program, "first_triangle_id");
 
     glGenVertexArrays(1, &vertex_array);
     glGenBuffers(1, &vertex_buffer);
@@ -311,6 +312,7 @@ struct EglRenderer::Impl {
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
     glFrontFace(GL_CW);
+    glProvokingVertex(GL_LAST_VERTEX_CONVENTION);  // the flat triangle id (setMesh)
     glViewport(0, 0, sensor.width, sensor.height);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
 
@@ -357,7 +359,6 @@ struct EglRenderer::Impl {
     std::size_t run_count = 0;
     auto flush = [&]() {
       if (run_count == 0) return;
-      glUniform1ui(uniform_first_triangle_id, static_cast<GLuint>(run_first + 1));
       glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * run_count), GL_UNSIGNED_INT,
                      reinterpret_cast<const void*>(3 * run_first * sizeof(GLuint)));
       triangles_drawn += run_count;
@@ -497,10 +498,40 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   Impl::Current current(*impl_);
   glBindVertexArray(impl_->vertex_array);
   glBindBuffer(GL_ARRAY_BUFFER, impl_->vertex_buffer);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(Eigen::Vector3f)),
-               mesh.vertices.data(), GL_STATIC_DRAW);
+  // Vertices with the id of the triangle they provoke (0 if none). Each triangle gets a provoking vertex of
+  // its own: one of its corners not yet taken, rotated last (the winding kept), or a copy of its last corner.
+  // The ISS's 5772 triangles need 5772 vertices (3040 shared ones).
+  struct Vertex {
+    float x, y, z;
+    std::uint32_t triangle_id;
+  };
+  std::vector<Vertex> corners;
+  corners.reserve(2 * mesh.vertices.size());
+  for (const Eigen::Vector3f& p : mesh.vertices) corners.push_back({p.x(), p.y(), p.z(), 0});
+  std::vector<bool> provoking(mesh.vertices.size(), false);
+  for (std::size_t t = 0; 3 * t < indices.size(); ++t) {
+    GLuint* tri = &indices[3 * t];
+    int corner = 2;
+    while (corner >= 0 && provoking[tri[corner]]) --corner;
+    if (corner < 0) {
+      corners.push_back(corners[tri[2]]);
+      provoking.push_back(false);
+      tri[2] = static_cast<GLuint>(corners.size() - 1);
+      corner = 2;
+    }
+    if (corner == 0) std::rotate(tri, tri + 1, tri + 3);
+    if (corner == 1) std::rotate(tri, tri + 2, tri + 3);
+    provoking[tri[2]] = true;
+    corners[tri[2]].triangle_id = static_cast<std::uint32_t>(t + 1);
+  }
+
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(corners.size() * sizeof(Vertex)), corners.data(),
+               GL_STATIC_DRAW);
   glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Eigen::Vector3f), nullptr);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribIPointer(1, 1, GL_UNSIGNED_INT, sizeof(Vertex),
+                         reinterpret_cast<const void*>(3 * sizeof(float)));
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->index_buffer);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)),
                indices.data(), GL_STATIC_DRAW);
