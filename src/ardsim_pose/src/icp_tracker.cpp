@@ -679,6 +679,14 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
       (correction_m > options_.max_correction_m || correction_rad > options_.max_correction_rad))
     return lost(format("diverged: %.2f m / %.2f deg from the prediction", correction_m,
                        correction_rad * 180.0 / M_PI));
+  // A boresight rotation judged unobserved at the end may still have turned in the iterations where it was
+  // observed: more than the divergence limit, and the frame is not TRACKING (an ISS frame at 7 m rolled 15
+  // deg about the docking adapter's near-symmetric axis and was reported TRACKING).
+  const double turn_from_prediction_rad =
+      Eigen::AngleAxisd(T.linear() * T_predicted.linear().transpose()).angle();
+  if (!acquiring && turn_from_prediction_rad > options_.max_correction_rad)
+    degraded.push_back(format("boresight rotation barely observed: %.2f deg from the prediction",
+                              turn_from_prediction_rad * 180.0 / M_PI));
   if (result.inlier_fraction < options_.lost_inlier_fraction)
     return lost(format("poor fit: inlier fraction %.2f < %.2f", result.inlier_fraction,
                        options_.lost_inlier_fraction));
