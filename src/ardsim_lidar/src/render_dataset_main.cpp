@@ -21,8 +21,10 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: render_dataset --target iss|hubble --poses POSES.csv --out DIR [--noise on|off] [--seed N]\n"
-    "                      [--width W] [--height H] [--fov-deg F]\n"
-    "POSES.csv rows: x y z qx qy qz qw, the pose of `target` in `lidar_optical` (m, Hamilton quaternion).";
+    "                      [--width W] [--height H] [--fov-deg F] [--arrays-deg A]\n"
+    "POSES.csv rows: x y z qx qy qz qw, the pose of `target` in `lidar_optical` (m, Hamilton quaternion).\n"
+    "--arrays-deg: the solar arrays turned by A degrees (ISS: both solar alpha rotary joints; Hubble: both\n"
+    "arrays about their masts), to test estimators whose model has them at 0.";
 
 struct Arguments {
   std::string target;
@@ -30,6 +32,7 @@ struct Arguments {
   std::string out;
   bool noise = true;
   std::uint64_t seed = 1;
+  double arrays_deg = 0.0;
   ardsim_lidar::SensorOptions sensor;
 };
 
@@ -37,6 +40,13 @@ long parseInteger(const std::string& flag, const std::string& text) {
   char* end = nullptr;
   const long value = std::strtol(text.c_str(), &end, 10);
   if (text.empty() || *end != '\0') throw std::invalid_argument(flag + " '" + text + "' is not an integer");
+  return value;
+}
+
+double parseNumber(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') throw std::invalid_argument(flag + " '" + text + "' is not a number");
   return value;
 }
 
@@ -69,10 +79,11 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (flag == "--height") {
       a.sensor.height = static_cast<int>(parseInteger(flag, value));
     } else if (flag == "--fov-deg") {
-      char* end = nullptr;
-      a.sensor.fov_deg = std::strtod(value.c_str(), &end);
-      if (value.empty() || *end != '\0')
-        throw std::invalid_argument("--fov-deg '" + value + "' is not a number");
+      a.sensor.fov_deg = parseNumber(flag, value);
+    } else if (flag == "--arrays-deg") {
+      a.arrays_deg = parseNumber(flag, value);
+      if (!(std::abs(a.arrays_deg) <= 360.0))
+        throw std::invalid_argument("--arrays-deg " + value + " is out of range: -360 .. 360");
     } else {
       throw std::invalid_argument("unknown option " + flag);
     }
@@ -103,7 +114,15 @@ int run(int argc, char** argv) {
   ardsim_lidar::NoiseOptions noise;
   noise.enabled = args.noise;
   ardsim_lidar::LidarSimulator simulator(args.sensor, noise, args.seed);
-  simulator.setTarget(ardsim_description::buildTarget(kind));
+  if (kind == ardsim_description::TargetKind::kIss) {
+    ardsim_description::IssOptions iss;
+    iss.sarj_port_deg = iss.sarj_starboard_deg = args.arrays_deg;
+    simulator.setTarget(ardsim_description::buildIss(iss));
+  } else {
+    ardsim_description::HubbleOptions hubble;
+    hubble.solar_array_deg = args.arrays_deg;
+    simulator.setTarget(ardsim_description::buildHubble(hubble));
+  }
   std::filesystem::create_directories(args.out);
   const std::filesystem::path out(args.out);
   std::ofstream truth(out / "truth.csv");
