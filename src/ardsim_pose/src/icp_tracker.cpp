@@ -455,10 +455,10 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     for (const Correspondence& c : correspondences_) scratch_.push_back(c.distance);
     gate = std::clamp(4.0 * median(&scratch_), options_.gate_min_m, gate);
   }
-  // The visibility of the final pose, for the coverage and silhouette checks: the last prediction serves while
-  // the pose has moved less than one of its 4 px cells in the image since (those checks allow a cell or more).
-  // Most tracking frames end that close to their prediction; a 0.2 m correction at 30 m (1.3 px) no longer
-  // costs a second prediction (0.4-0.9 ms a frame in the benchmark; with a 1 px limit it did).
+  // The visibility of the final pose, for the coverage and silhouette checks: the last prediction serves
+  // while the pose has moved less than one of its 4 px cells in the image since (those checks allow a cell or
+  // more). Most tracking frames end that close to their prediction; a 0.2 m correction at 30 m (1.3 px) no
+  // longer costs a second prediction (0.4-0.9 ms a frame in the benchmark; with a 1 px limit it did).
   predictVisibility(T, 4.0);
   return a;
 }
