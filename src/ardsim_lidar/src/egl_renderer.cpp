@@ -48,7 +48,7 @@ void main() {
 
 // A visibility buffer: each pixel keeps the id of the nearest triangle (the range and the incidence follow
 // exactly on the CPU from its plane and the pixel's ray). Cheaper than shading on llvmpipe (render 1.5-3.3 ->
-// 1.1-2.3 ms a frame) and a quarter of the readback. The id comes flat from each triangle's provoking (last)
+// 1.0-2.0 ms a frame) and a quarter of the readback. The id comes flat from each triangle's provoking (last)
 // vertex, which setMesh makes its own: gl_PrimitiveID cost llvmpipe another 0.2-0.3 ms a frame.
 constexpr const char* kFragmentShader = R"(#version 330 core
 flat in uint triangle_id_vertex;
