@@ -38,8 +38,8 @@ VehicleModel buildTargetModel(TargetKind kind) {
   return kind == TargetKind::kIss ? buildIssModel() : buildHubbleModel();
 }
 
-TriangleMesh buildTarget(TargetKind kind) {
-  return buildTargetModel(kind).mesh;
+TriangleMesh buildTarget(TargetKind kind, const IssOptions& iss, const HubbleOptions& hubble) {
+  return kind == TargetKind::kIss ? buildIss(iss) : buildHubble(hubble);
 }
 
 }  // namespace ardsim_description

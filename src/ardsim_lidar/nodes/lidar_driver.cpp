@@ -155,9 +155,7 @@ LidarDriver::LidarDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
       simulator_(options_.sensor, options_.noise, options_.seed, options_.renderer),
       T_chaser_lidar_(ardsim_description::T_chaser_lidar()),
       synchronizer_(target_subscriber_, chaser_subscriber_, 10) {
-  simulator_.setTarget(options_.target == ardsim_description::TargetKind::kIss
-                           ? ardsim_description::buildIss(options_.iss)
-                           : ardsim_description::buildHubble(options_.hubble));
+  simulator_.setTarget(ardsim_description::buildTarget(options_.target, options_.iss, options_.hubble));
   empty_frame_.width = options_.sensor.width;
   empty_frame_.height = options_.sensor.height;
   const std::size_t pixels = static_cast<std::size_t>(options_.sensor.width) * options_.sensor.height;

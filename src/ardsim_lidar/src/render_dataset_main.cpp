@@ -114,15 +114,11 @@ int run(int argc, char** argv) {
   ardsim_lidar::NoiseOptions noise;
   noise.enabled = args.noise;
   ardsim_lidar::LidarSimulator simulator(args.sensor, noise, args.seed);
-  if (kind == ardsim_description::TargetKind::kIss) {
-    ardsim_description::IssOptions iss;
-    iss.sarj_port_deg = iss.sarj_starboard_deg = args.arrays_deg;
-    simulator.setTarget(ardsim_description::buildIss(iss));
-  } else {
-    ardsim_description::HubbleOptions hubble;
-    hubble.solar_array_deg = args.arrays_deg;
-    simulator.setTarget(ardsim_description::buildHubble(hubble));
-  }
+  ardsim_description::IssOptions iss;
+  iss.sarj_port_deg = iss.sarj_starboard_deg = args.arrays_deg;
+  ardsim_description::HubbleOptions hubble;
+  hubble.solar_array_deg = args.arrays_deg;
+  simulator.setTarget(ardsim_description::buildTarget(kind, iss, hubble));
   std::filesystem::create_directories(args.out);
   const std::filesystem::path out(args.out);
   std::ofstream truth(out / "truth.csv");

@@ -28,8 +28,8 @@ TriangleMesh buildHubble(const HubbleOptions& options = {});
 
 TriangleMesh buildChaser();
 
-// The target with default options.
-TriangleMesh buildTarget(TargetKind kind);
+// The target of that kind, with its articulation options (those of the other kind are not used).
+TriangleMesh buildTarget(TargetKind kind, const IssOptions& iss = {}, const HubbleOptions& hubble = {});
 
 // Everything the simulation knows about a vehicle's shape and mass, built from one set of primitives so that
 // the rendered mesh and the collision shapes cannot disagree. The mesh's topology (vertex and triangle counts
