@@ -24,6 +24,10 @@ constexpr int kSearchStride = 3;
 constexpr int kCoarseStride = 3;
 constexpr double kCoarseFactor = 10.0;
 constexpr int kFineIterations = 3;
+// The balls of model points kept per scan point reach this far beyond its nearest (IcpTracker::
+// nearestVisible): wide enough that the iterations after the first few stay inside, narrow enough to hold
+// few points.
+constexpr float kNeighbourhoodMarginM = 0.03f;
 
 void require(bool ok, const std::string& name, double value, const std::string& allowed) {
   if (!ok) throw std::invalid_argument(name + " = " + std::to_string(value) + " is out of range: " + allowed);
@@ -268,6 +272,7 @@ void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_
                             (tolerance_px > 0.0 && imageMotionPx(visibility_pose_, T) <= tolerance_px)))
     return;
   visibility_.predict(*model_, T, &visible_);
+  ++visibility_generation_;
   visibility_pose_ = T;
   visibility_valid_ = true;
 }
@@ -323,14 +328,44 @@ void IcpTracker::gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isom
   if (static_cast<int>(gated_.size()) < options_.min_points) gated_ = valid_;
 }
 
+int IcpTracker::nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, float* distance_sq) {
+  Neighbourhood& ball = neighbourhoods_[k];
+  if (ball.radius_m > 0.0f) {
+    // Points outside the ball lie at least radius - |q - centre| from q (a hair less for rounding).
+    const float reach = 0.999f * ball.radius_m - (q - ball.centre).norm();
+    if (reach > 0.0f) {
+      float best_sq = gate_sq;
+      int best = -1;
+      for (std::uint32_t i = ball.begin; i < ball.end; ++i) {
+        const float d = model_->distanceSq(q, neighbourhood_points_[i]);
+        if (d < best_sq) {
+          best_sq = d;
+          best = static_cast<int>(neighbourhood_points_[i]);
+        }
+      }
+      if (best_sq <= reach * reach) {  // found, or none within a gate inside the ball
+        *distance_sq = best_sq;
+        return best;
+      }
+    }
+  }
+  ball.centre = q;
+  ball.begin = static_cast<std::uint32_t>(neighbourhood_points_.size());
+  const int j = model_->nearestVisibleWithNeighbours(q, gate_sq, visible_, kNeighbourhoodMarginM, distance_sq,
+                                                     &ball.radius_m, &neighbourhood_points_);
+  ball.end = static_cast<std::uint32_t>(neighbourhood_points_.size());
+  return j;
+}
+
 IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double gate, int max_iterations,
                                         bool prune_unmatched, int stride) {
   Alignment a;
   a.T = T_start;
   const auto selectActive = [&](int every) {
     active_.clear();
-    for (std::size_t k = 0; k < scan_.size(); k += every) active_.push_back(scan_[k]);
+    for (std::size_t k = 0; k < scan_.size(); k += every) active_.push_back(static_cast<int>(k));
   };
+  neighbourhood_generation_ = -1;  // the balls of an earlier alignment are of other scan points
   // Coarse first only where a third of the points is still plenty and the limit leaves room for it.
   bool coarse = stride == 1 && max_iterations > kFineIterations &&
                 static_cast<int>(scan_.size()) >= 2 * kCoarseStride * options_.min_points;
@@ -348,15 +383,21 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
     const Eigen::Matrix3d R = T.linear();
     correspondences_.clear();
+    if (neighbourhood_generation_ != visibility_generation_) {
+      neighbourhoods_.assign(scan_.size(), Neighbourhood{});
+      neighbourhood_points_.clear();
+      neighbourhood_generation_ = visibility_generation_;
+    }
     const float gate_sq = static_cast<float>(gate * gate);
     std::size_t kept = 0;
-    for (const Eigen::Vector3f& s : active_) {
+    for (const int k : active_) {
+      const Eigen::Vector3f& s = scan_[k];
       float distance_sq = 0.0f;
-      const int j = model_->nearestVisible(T_target_lidar * s, gate_sq, visible_, &distance_sq);
+      const int j = nearestVisible(k, T_target_lidar * s, gate_sq, &distance_sq);
       if (j < 0) continue;
       // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
       // solar arrays, background returns. Searching for it again each iteration is the costliest query.
-      if (prune_unmatched) active_[kept++] = s;
+      if (prune_unmatched) active_[kept++] = k;
       Correspondence c;
       c.scan = s.cast<double>();
       c.model = T * model_->points()[j].cast<double>();

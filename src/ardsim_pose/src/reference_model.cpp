@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include <nanoflann.hpp>
 
@@ -97,6 +98,31 @@ struct NearestVisibleResult {
     return true;
   }
   float worstDist() const { return best_distance_sq; }
+  bool full() const { return best_index >= 0; }
+};
+
+// The nearest visible point, collecting on the way every visible point within margin of it: the search
+// reach is the nearest distance found so far plus the margin (the gate until one is found).
+struct NeighbourhoodResult {
+  const std::uint8_t* visible;
+  float max_distance_sq;
+  float margin;
+  std::vector<std::pair<float, std::uint32_t>>* found;
+  float reach_sq = max_distance_sq;
+  float best_distance_sq = max_distance_sq;
+  std::int64_t best_index = -1;
+  bool addPoint(float distance_sq, std::uint32_t index) {
+    if (!visible[index] || !(distance_sq < reach_sq)) return true;
+    found->push_back({distance_sq, index});
+    if (distance_sq < best_distance_sq) {
+      best_distance_sq = distance_sq;
+      best_index = index;
+      const float reach = std::sqrt(distance_sq) + margin;
+      reach_sq = std::min(max_distance_sq, reach * reach);
+    }
+    return true;
+  }
+  float worstDist() const { return reach_sq; }
   bool full() const { return best_index >= 0; }
 };
 
@@ -196,6 +222,22 @@ int ReferenceModel::nearestVisible(const Eigen::Vector3f& query, float max_dista
   NearestVisibleResult result{visible.data(), max_distance_sq};
   tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
   *distance_sq = result.best_distance_sq;
+  return static_cast<int>(result.best_index);
+}
+
+int ReferenceModel::nearestVisibleWithNeighbours(const Eigen::Vector3f& query, float max_distance_sq,
+                                                 const std::vector<std::uint8_t>& visible, float margin_m,
+                                                 float* distance_sq, float* radius_m,
+                                                 std::vector<std::uint32_t>* near) const {
+  thread_local std::vector<std::pair<float, std::uint32_t>> found;
+  found.clear();
+  NeighbourhoodResult result{visible.data(), max_distance_sq, margin_m, &found};
+  tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  // Points collected while the reach was still wider lie beyond the final ball: left out, it is exact.
+  for (const auto& [d, index] : found)
+    if (d < result.reach_sq) near->push_back(index);
+  *distance_sq = result.best_distance_sq;
+  *radius_m = std::sqrt(result.reach_sq);
   return static_cast<int>(result.best_index);
 }
 

@@ -163,7 +163,23 @@ class IcpTracker : public PoseMethod {
   Eigen::Isometry3d visibility_pose_ = Eigen::Isometry3d::Identity();  // pose of the last prediction
   bool visibility_valid_ = false;
   std::vector<Eigen::Vector3f> scan_;
-  std::vector<Eigen::Vector3f> active_;  // scan points still searched for
+  std::vector<int> active_;  // indices of the scan_ points still searched for
+  // Per scan_ point, the visible model points in a ball around where it was last searched (target frame):
+  // while it stays well inside that ball, its nearest visible model point is among them (exact, and most
+  // iterations move the points by millimetres). Valid for the visibility prediction they were built with.
+  struct Neighbourhood {
+    Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+    float radius_m = -1.0f;  // < 0: none
+    std::uint32_t begin = 0;
+    std::uint32_t end = 0;
+  };
+  std::vector<Neighbourhood> neighbourhoods_;
+  std::vector<std::uint32_t> neighbourhood_points_;  // the balls' model point indices
+  int visibility_generation_ = 0;                    // counts the visibility predictions
+  int neighbourhood_generation_ = -1;                // the prediction the balls were built with
+  // The nearest visible model point to q (target frame) within the gate for scan_ point k, from its ball
+  // when that answers exactly, else from the tree (and a new ball).
+  int nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, float* distance_sq);
   std::vector<int> valid_;
   std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows

@@ -46,6 +46,23 @@ class ReferenceModel {
   // Nearest point with visible[index] != 0 within sqrt(max_distance_sq) of query (target frame); -1 if none.
   int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
                      const std::vector<std::uint8_t>& visible, float* distance_sq) const;
+  // nearestVisible that also appends to near every visible point within margin_m of the nearest one's
+  // distance (every visible point within the gate when there is none) and sets radius_m to the radius of the
+  // ball around query that near then covers: a later query q' with a nearest candidate in near closer than
+  // radius_m - |q' - query| has found its nearest visible point.
+  int nearestVisibleWithNeighbours(const Eigen::Vector3f& query, float max_distance_sq,
+                                   const std::vector<std::uint8_t>& visible, float margin_m,
+                                   float* distance_sq, float* radius_m,
+                                   std::vector<std::uint32_t>* near) const;
+  // Squared distance from query to point index, computed as the tree computes it.
+  float distanceSq(const Eigen::Vector3f& query, std::uint32_t index) const {
+    float sum = 0.0f;
+    for (int d = 0; d < 3; ++d) {
+      const float diff = query[d] - points_[index][d];
+      sum += diff * diff;
+    }
+    return sum;
+  }
   // Whether any model point, visible or not, lies within sqrt(max_distance_sq) of query (target frame).
   bool anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const;
 
