@@ -51,9 +51,11 @@ void prepareFrame(const OrganizedCloud& cloud, const AdapterFitOptions& options,
   frame->height = cloud.height;
   frame->points.resize(n);
   frame->range_m.resize(n);
+  frame->saturated.resize(n);
   frame->valid_count = 0;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const bool has_intensity = cloud.intensity.size() == cloud.points.size();
+  frame->has_intensity = has_intensity;
   if (static_cast<int>(cloud.points.size()) != n) {
     std::fill(frame->range_m.begin(), frame->range_m.end(), nan);
     return;
@@ -67,8 +69,9 @@ void prepareFrame(const OrganizedCloud& cloud, const AdapterFitOptions& options,
     const Eigen::Vector3f& p = cloud.points[i];
     const float r = p.norm();
     const bool valid = std::isfinite(r) && r > 0.0f;
+    frame->saturated[i] = has_intensity && cloud.intensity[i] >= 1.0f;
     // Saturated returns read short by the detector walk: put it back along the ray.
-    const bool saturated = correct && cloud.intensity[i] >= 1.0f;
+    const bool saturated = correct && frame->saturated[i];
     const float range = saturated ? r - bias : r;
     const float scale = saturated ? range / r : 1.0f;
     frame->points[i] = valid ? Eigen::Vector3f(p * scale) : Eigen::Vector3f::Constant(nan);
@@ -599,6 +602,66 @@ bool AdapterFitter::fitRound(const PreparedFrame& frame, const std::vector<int>&
   return true;
 }
 
+double AdapterFitter::reflectorAngle(const PreparedFrame& frame, const Eigen::Isometry3d& T_port0_lidar,
+                                     double d, AdapterFitReport* report) const {
+  const AdapterGeometry& g = geometry_;
+  // Points on the discs' faces: from 2.5 cm behind (the brackets' faces lie 3 cm behind) to 10 cm in front,
+  // within a disc radius (and 2 cm) of the reflectors' circle. Each disc's angle is the circular mean of its
+  // points' angles (on three times the angle, less 180 deg: the discs sit 60 deg off the petals).
+  const double face_min = g.reflector_face_x_m - 0.025, face_max = g.reflector_face_x_m + 0.1;
+  const double radius_min = g.reflector_radius_m - g.reflector_disc_radius_m - 0.02;
+  const double radius_max = g.reflector_radius_m + g.reflector_disc_radius_m + 0.02;
+  struct DiscPoint {
+    double angle;
+    std::complex<double> unit3;
+    bool border;
+  };
+  std::vector<DiscPoint> points;
+  std::complex<double> total = 0.0;
+  const double along_min = d + face_min - 1e-6, along_max = d + face_max + 1e-6;
+  const int pixels = frame.width * frame.height;
+  for (int i = 0; i < pixels; ++i) {
+    if (!frame.isValid(i) || along_[i] <= along_min || along_[i] >= along_max) continue;
+    // The blooming around a disc (its range on neighbouring pixels, weaker) would widen it at random.
+    if (frame.has_intensity && !frame.saturated[i]) continue;
+    const Eigen::Vector3d q = T_port0_lidar * frame.points[i].cast<double>();
+    if (q.x() <= face_min || q.x() >= face_max) continue;
+    const double radius = std::sqrt(q.y() * q.y() + q.z() * q.z());
+    if (radius <= radius_min || radius >= radius_max) continue;
+    const double angle = std::atan2(q.z(), q.y());
+    points.push_back({angle, -std::polar(1.0, 3.0 * angle), onBorder(frame, i)});
+    total += points.back().unit3;
+  }
+  // Per disc (nearest of the discs at the first estimate), those touching the border left out. Only points
+  // on a disc's face at the first estimate count: a spurious return elsewhere on the circle (background,
+  // hot pixels) would pull a disc's mean by its whole angle / count (0.3 deg seen at 10 m).
+  const double first_disc = std::arg(total) / 3.0 + M_PI / 3.0;
+  const double half_width =
+      std::asin(std::min(1.0, (g.reflector_disc_radius_m + 0.04) / g.reflector_radius_m));
+  std::array<std::complex<double>, 3> per_disc{};
+  std::array<int, 3> per_disc_count{};
+  std::array<bool, 3> per_disc_border{};
+  for (const DiscPoint& p : points) {
+    const long branch = std::lround(wrapPi(p.angle - first_disc) / (2.0 * M_PI / 3.0));
+    if (std::abs(wrapPi(p.angle - first_disc - branch * 2.0 * M_PI / 3.0)) > half_width) continue;
+    const int k = static_cast<int>(((branch % 3) + 3) % 3);
+    per_disc[k] += p.unit3;
+    ++per_disc_count[k];
+    per_disc_border[k] = per_disc_border[k] || p.border;
+  }
+  std::complex<double> sum = 0.0;
+  int discs = 0, count = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (per_disc_border[k] || per_disc_count[k] < options_.min_reflector_points) continue;
+    sum += per_disc[k] / static_cast<double>(per_disc_count[k]);  // each disc counts once
+    ++discs;
+    count += per_disc_count[k];
+  }
+  report->reflector_points = count;
+  report->reflectors = discs >= 2 && std::abs(sum) >= options_.min_resultant * discs;
+  return std::arg(sum) / 3.0;
+}
+
 bool AdapterFitter::onBorder(const PreparedFrame& frame, int pixel) const {
   const int u = pixel % frame.width, v = pixel / frame.width;
   return u < 2 || v < 2 || u >= frame.width - 2 || v >= frame.height - 2;
@@ -718,7 +781,14 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   } else if (r.report.cross_angle) {
     boresight = nearestBranch(cross_angle, M_PI / 2.0, prior_angle);
   }
-  result.boresight_rotation_observed = r.report.petals || r.report.cross_angle;
+  // The reflector targets lie three times further out than the petals: their discs' angles, where two or
+  // more are whole in the view (inside ~7 m they leave it), refine the branch chosen above.
+  const double reflector_angle = reflectorAngle(frame, T_port0_lidar, r.d, &r.report);
+  if (r.report.reflectors) {
+    const double reference = r.report.petals || r.report.cross_angle ? boresight : prior_angle;
+    boresight = nearestBranch(reflector_angle, 2.0 * M_PI / 3.0, reference);
+  }
+  result.boresight_rotation_observed = r.report.petals || r.report.cross_angle || r.report.reflectors;
   // Tracking: a measurement close to the prediction only pulls it part of the way (the angle changes slowly,
   // the petals' centroids are noisy at several metres); a far one (a new prior, a hand-over) is taken as it
   // is.

@@ -35,6 +35,11 @@ struct AdapterGeometry {
   double petal_top_x_m = 0.28;        // guide petals stand out of the docking plane, inside the passage
   double petal_min_radius_m = 0.26;
   double petal_max_radius_m = 0.40;
+  // Three peripheral retro-reflector targets at 60 + 120 k deg (between the petals), on brackets from the
+  // tunnel: discs facing out of the port, their centres reflector_radius_m from the axis.
+  double reflector_radius_m = 1.125;
+  double reflector_disc_radius_m = 0.075;
+  double reflector_face_x_m = -0.27;
   Eigen::Isometry3d T_target_port = Eigen::Isometry3d::Identity();  // from ardsim_description::T_target_port
 };
 
@@ -59,6 +64,7 @@ struct AdapterFitOptions {
       0.03;                   // fitted inner radius within this of the model, or the circle is rejected
   int min_cross_points = 20;  // cross-face points for the lateral position and the boresight angle
   int min_petal_points = 12;
+  int min_reflector_points = 20;  // per reflector disc; the boresight angle needs two whole discs
   double boresight_gain =
       0.3;  // a boresight measurement within the gate of the prediction moves it this much
   double boresight_gate_deg = 1.5;  // beyond: the measurement is taken as it is
@@ -76,6 +82,10 @@ struct PreparedFrame {
   int height = 0;
   std::vector<Eigen::Vector3f> points;  // NaN where no return
   std::vector<float> range_m;           // NaN where no return
+  // Saturated returns (intensity 1): a retro-reflector's own pixels, not the weaker spill of its blooming
+  // around it. All 0 when the cloud has no intensity (has_intensity false).
+  std::vector<std::uint8_t> saturated;
+  bool has_intensity = false;
   int valid_count = 0;
   bool isValid(int i) const { return range_m[i] == range_m[i]; }
 };
@@ -93,10 +103,12 @@ struct AdapterFitReport {
   bool cross = false;        // the centreline cross seen well enough for the lateral position
   bool petals = false;       // boresight angle measured from the petals
   bool cross_angle = false;  // boresight angle measured from the cross
+  bool reflectors = false;   // boresight angle measured from the peripheral reflector targets
   int plane_points = 0;
   int edge_points = 0;
   int cross_points = 0;
   int petal_points = 0;
+  int reflector_points = 0;
   double inner_radius_m = 0.0;
   double edge_arc_deg = 0.0;
   double plane_rms_m = 0.0;
@@ -162,6 +174,11 @@ class AdapterFitter {
                 const Eigen::Isometry3d& T_lidar_port_guess, double band, const Sampling& sampling,
                 RoundResult* out, std::string* reason);
   bool onBorder(const PreparedFrame& frame, int pixel) const;
+  // Boresight angle (rad, modulo 120 deg) from the peripheral reflector targets' discs, in the frame of the
+  // fitted plane (T_port0_lidar: port frame at boresight angle 0; d: the plane's offset along its normal,
+  // with along_ from the last round); sets report's reflectors and reflector_points.
+  double reflectorAngle(const PreparedFrame& frame, const Eigen::Isometry3d& T_port0_lidar, double d,
+                        AdapterFitReport* report) const;
   // Joint fit of the unit normal n and offset d with n.p = d + face_x for every point (robust, a few
   // Gauss-Newton steps); returns false with too few inliers (each point standing for pixels_per_point).
   bool fitPlanes(std::vector<PlanePoint>& points, int pixels_per_point, Eigen::Vector3d* normal,
