@@ -83,6 +83,9 @@ void validate(const IcpOptions& o) {
           "0 .. 1");
   require(positive(o.degraded_weak_slide_px), "icp/degraded_weak_slide_px", o.degraded_weak_slide_px, "> 0");
   require(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
+  require(
+      std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
+      "icp/boresight_prior_deg", o.boresight_prior_deg, "0 .. 180");
   require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
           "> 0");
   require(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad, "> 0");
@@ -188,15 +191,19 @@ Eigen::Matrix<double, 6, 6> IcpTracker::leverScaled(const Eigen::Matrix<double, 
   return scale.asDiagonal() * H * scale.asDiagonal();
 }
 
-bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest) const {
+double IcpTracker::boresightInformation(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest) const {
   // The information about the boresight rotation once the other five are free, against the largest
   // eigenvalue.
   const Eigen::Matrix<double, 6, 1> column = H_scaled.ldlt().solve(Eigen::Matrix<double, 6, 1>::Unit(5));
-  return largest > 0.0 && column(5) > 0.0 && 1.0 / column(5) / largest > options_.degraded_condition;
+  return largest > 0.0 && column(5) > 0.0 ? 1.0 / column(5) / largest : 0.0;
+}
+
+bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest) const {
+  return boresightInformation(H_scaled, largest) > options_.degraded_condition;
 }
 
 void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest,
-                                    const Alignment& a, Eigen::Matrix<double, 6, 1>* delta,
+                                    const Alignment& a, double gate_m, Eigen::Matrix<double, 6, 1>* delta,
                                     Eigen::Matrix<double, 6, 1>* weak_step) const {
   // The plane fit's directions (lever-scaled) with less than weak_direction_condition of its largest
   // information: the step there comes from the tangential offsets instead (none: held). Among the first five
@@ -218,6 +225,7 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
   const Eigen::Isometry3f T_target_lidar = a.T.inverse().cast<float>();
   Eigen::Matrix<double, 6, 6> H_tangential = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> g_tangential = Eigen::Matrix<double, 6, 1>::Zero();
+  double largest_offset_m = 0.0;  // beyond the sampling
   for (const Correspondence& c : correspondences_) {
     const double w = tukeyWeight(c.residual, a.limit_m);
     if (w == 0.0) continue;
@@ -236,6 +244,7 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
     A.rightCols<3>() = -P * skew(c.model - a.centre);
     H_tangential.noalias() += w * A.transpose() * A;
     g_tangential.noalias() += (w * (1.0 - sampling / e_norm)) * A.transpose() * e;
+    largest_offset_m = std::max(largest_offset_m, e_norm - sampling);
   }
 
   Eigen::MatrixXd U = Eigen::MatrixXd::Zero(6, weak);  // scaled coordinates
@@ -250,8 +259,34 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
   const Eigen::VectorXd z = H_weak.ldlt().solve(D.transpose() * g_tangential);
   if (z.allFinite() && H_weak.trace() > 0.0) {
     *weak_step = D * z;
+    // A few offsets that barely constrain a weak direction make their normal equations near singular: the
+    // step then ran to hundreds of metres (Hubble end-on, 27 m). A step (lever-scaled) beyond the
+    // correspondence gate is that, not data: it is cut to the largest offset (closing the offsets never
+    // takes more).
+    const double size_m = weak_step->cwiseQuotient(scale).norm();
+    if (size_m > gate_m) *weak_step *= largest_offset_m / size_m;
     *delta += *weak_step;
   }
+}
+
+double IcpTracker::weakPart(const Eigen::Isometry3d& T_from, const Eigen::Isometry3d& T_to,
+                            const Eigen::Vector3d& centre,
+                            const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>& eigen,
+                            double largest) const {
+  // The twist (v, w) about centre from T_from to T_to (p' = p + w x (p - centre) + v, as the steps), in the
+  // lever-scaled coordinates of the normal equations, projected on the eigenvectors of the first five
+  // unknowns whose information is below weak_direction_condition of the largest.
+  const Eigen::AngleAxisd turn(T_to.linear() * T_from.linear().transpose());
+  const Eigen::Vector3d w = turn.angle() * turn.axis();
+  const Eigen::Vector3d v =
+      T_to.translation() - T_from.translation() - w.cross(T_from.translation() - centre);
+  Eigen::Matrix<double, 6, 1> twist;
+  twist << v, w;
+  const Eigen::Matrix<double, 6, 1> scaled = twist.cwiseQuotient(leverScale(centre));
+  Eigen::Matrix<double, 5, 1> weak = Eigen::Matrix<double, 5, 1>::Zero();
+  for (int k = 0; k < 5 && eigen.eigenvalues()(k) < options_.weak_direction_condition * largest; ++k)
+    weak += eigen.eigenvectors().col(k) * eigen.eigenvectors().col(k).dot(scaled.head<5>());
+  return weak.norm();
 }
 
 double IcpTracker::imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) const {
@@ -456,14 +491,30 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     const double largest =
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
             .eigenvalues()(5);
-    if (boresightObserved(H_scaled, largest)) {
-      delta = a.H.ldlt().solve(g);
+    const double boresight_information = boresightInformation(H_scaled, largest);
+    if (boresight_information > options_.degraded_condition) {
+      // Tracking, with the boresight rotation barely observed (below 10 x the observed limit: Hubble's
+      // bulkhead end-on, the ISS's docking adapter filling the view; the ISS from 12 m out is above): a prior
+      // at the prediction (T_start) of boresight_prior_deg, in the units of the normal equations (the robust
+      // sigma squared over the prior's). Without it the rotation wandered 10-20 deg a frame on noise there.
+      Eigen::Matrix<double, 6, 6> H_solve = a.H;
+      Eigen::Matrix<double, 6, 1> g_solve = g;
+      if (prune_unmatched && options_.boresight_prior_deg > 0.0 &&
+          boresight_information < 10.0 * options_.degraded_condition) {
+        const double prior_rad = options_.boresight_prior_deg * M_PI / 180.0;
+        const double information = sigma * sigma / (prior_rad * prior_rad);
+        const Eigen::AngleAxisd turn(T.linear() * T_start.linear().transpose());
+        H_solve(5, 5) += information;
+        g_solve(5) -= information * turn.angle() * turn.axis().z();
+      }
+      delta = H_solve.ldlt().solve(g_solve);
     } else {
       delta.head<5>() = a.H.topLeftCorner<5, 5>().ldlt().solve(g.head<5>());
     }
     // The weak directions' part of the step (from the tangential offsets), judged on its own below.
     Eigen::Matrix<double, 6, 1> weak_step = Eigen::Matrix<double, 6, 1>::Zero();
-    if (options_.weak_direction_condition > 0.0) stepWeakDirections(H_scaled, largest, a, &delta, &weak_step);
+    if (options_.weak_direction_condition > 0.0)
+      stepWeakDirections(H_scaled, largest, a, gate, &delta, &weak_step);
     if (!delta.allFinite()) {
       a.failure = "diverged: singular normal equations";
       return a;
@@ -697,11 +748,9 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   // the other five are well constrained: judge the condition of those five.
   // The weakest of the five unknowns besides the boresight rotation, relative to the largest: also what
   // says whether the weak-direction step was taken (weak_direction_condition).
-  const double condition_of_five = largest > 0.0 ? Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>(
-                                                       H_scaled.topLeftCorner<5, 5>(), Eigen::EigenvaluesOnly)
-                                                           .eigenvalues()(0) /
-                                                       largest
-                                                 : 0.0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> eigen_of_five(
+      H_scaled.topLeftCorner<5, 5>());
+  const double condition_of_five = largest > 0.0 ? eigen_of_five.eigenvalues()(0) / largest : 0.0;
   const double condition_of_the_rest = result.boresight_rotation_observed ? condition : condition_of_five;
 
   coverage_ = coverage();
@@ -744,10 +793,14 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   if (coverage_ < options_.degraded_coverage) degraded.push_back(format("coverage %.2f", coverage_));
   const double footprint_m = T.translation().norm() / std::min(intrinsics_.fx, intrinsics_.fy);
   if (options_.weak_direction_condition > 0.0 && largest > 0.0 &&
-      correction_m > options_.degraded_weak_slide_px * footprint_m &&
-      condition_of_five < options_.weak_direction_condition)
-    degraded.push_back(format("weakly observed directions: %.3f m from the prediction > %.3f m", correction_m,
-                              options_.degraded_weak_slide_px * footprint_m));
+      condition_of_five < options_.weak_direction_condition) {
+    // Only the correction's part in the weak directions counts: a step along a well observed one (Hubble's
+    // range, its bulkhead seen face-on) is measured, not slid.
+    const double weak_slide_m = weakPart(T_predicted, T, a.centre, eigen_of_five, largest);
+    if (weak_slide_m > options_.degraded_weak_slide_px * footprint_m)
+      degraded.push_back(format("weakly observed directions: %.3f m from the prediction > %.3f m",
+                                weak_slide_m, options_.degraded_weak_slide_px * footprint_m));
+  }
   if (condition_of_the_rest < options_.degraded_condition)
     degraded.push_back(format("poorly constrained (condition %.1e)", condition));
   // Acquisition ends when a frame agrees with the one before (its prediction), or with the constant-velocity

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "ardsim_lidar/sensor.h"
 #include "ardsim_pose/pose_types.h"
 #include "ardsim_pose/reference_model.h"
@@ -38,7 +40,11 @@ struct IcpOptions {
   // target's range) has likely stopped short of the truth: DEGRADED. Within it, the frame-to-frame wander of
   // a tracked pose inside the sampling.
   double degraded_weak_slide_px = 1.0;
-  double min_sigma_m = 0.01;              // floor of the robust sigma (the sensor's range noise)
+  double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
+  // Tracking: the rotation about the boresight is held near the prediction with this standard deviation
+  // (deg; a prior in the normal equations): where the scan barely observes it (a near-symmetric docking
+  // adapter filling the view, Hubble end-on) it no longer wanders on noise. 0: no prior.
+  double boresight_prior_deg = 0.2;
   double converged_translation_m = 1e-4;  // an update smaller than both ends the iterations
   double converged_rotation_rad = 1e-5;
   double revisibility_translation_m = 0.3;  // recompute the visibility when the pose moved more than this
@@ -127,6 +133,12 @@ class IcpTracker : public PoseMethod {
   // visibility_.predict at T into visible_, unless the last prediction was at exactly T or (tolerance_px
   // > 0) at a pose that puts every scan point within tolerance_px of where T puts it.
   void predictVisibility(const Eigen::Isometry3d& T, double tolerance_px = 0.0);
+  // The norm (m; rotations times the correspondences' lever arm) of the move from T_from to T_to in the weak
+  // directions of the lever-scaled normal equations about centre (eigen: of their first five unknowns).
+  double weakPart(const Eigen::Isometry3d& T_from, const Eigen::Isometry3d& T_to,
+                  const Eigen::Vector3d& centre,
+                  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>& eigen,
+                  double largest) const;
   // An upper bound on how far, in pixels, a scan point moves in the image between poses a and b.
   double imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) const;
   // H with its rotation rows and columns scaled by the correspondences' lever arm about centre.
@@ -136,13 +148,17 @@ class IcpTracker : public PoseMethod {
   Eigen::Matrix<double, 6, 1> leverScale(const Eigen::Vector3d& centre) const;
   // Replaces delta's part in the weak directions of H_scaled (see weak_direction_condition) by the
   // Gauss-Newton step of the tangential offsets' normal equations there (also into weak_step), from the
-  // correspondences and the Tukey limit and centre of the iteration a.
+  // correspondences and the Tukey limit and centre of the iteration a; a step beyond gate_m (a near-singular
+  // solve) is cut back.
   void stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest, const Alignment& a,
-                          Eigen::Matrix<double, 6, 1>* delta, Eigen::Matrix<double, 6, 1>* weak_step) const;
+                          double gate_m, Eigen::Matrix<double, 6, 1>* delta,
+                          Eigen::Matrix<double, 6, 1>* weak_step) const;
   // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the
   // boresight: its information with the other five free, over the largest eigenvalue, above
   // degraded_condition.
   bool boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest) const;
+  // That information ratio itself (0 when none).
+  double boresightInformation(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest) const;
   // silhouette_: the cells with a surface in the last visibility prediction, dilated by r cells.
   void markSilhouette(int r);
   // Of the scan points on the model's silhouette at the pose of the last visibility prediction (a cell with
