@@ -217,10 +217,12 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
   if (weak == 0) return;
 
   // Normal equations of the offsets to the nearest model points across their normals, e = P (s - m) with
-  // P = 1 - n n^T, counted beyond the model's sample spacing and the pixel's footprint (inside a surface the
-  // offset is only the sampling: points past a rim or an edge give it), Tukey-weighted as the plane
-  // residuals; a twist moves e by -A (v, w), A = [P, -P [m - c]x]. Built only here: most ISS iterations have
-  // no weak direction.
+  // P = 1 - n n^T, counted beyond the model's sample spacing and half the pixel's footprint (inside a surface
+  // the offset is only the sampling: points past a rim or an edge give it; a rim seen by many pixels is
+  // placed better than a whole footprint: with a whole one Hubble's lateral error was 3.9 cm RMS on the
+  // approach dataset, with half 3.0, hubble_hold 3.2 -> 2.2 cm), Tukey-weighted as the plane residuals; a
+  // twist moves e by -A (v, w), A = [P, -P [m - c]x]. Built only here: most ISS iterations have no weak
+  // direction.
   const double pixel_pitch_rad = 1.0 / std::min(intrinsics_.fx, intrinsics_.fy);
   const Eigen::Isometry3f T_target_lidar = a.T.inverse().cast<float>();
   Eigen::Matrix<double, 6, 6> H_tangential = Eigen::Matrix<double, 6, 6>::Zero();
@@ -232,7 +234,7 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
     const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - c.normal * c.normal.transpose();
     const Eigen::Vector3d e = P * (c.scan - c.model);
     const double e_norm = e.norm();
-    const double sampling = std::max(c.spacing, c.scan.norm() * pixel_pitch_rad);
+    const double sampling = std::max(c.spacing, 0.5 * c.scan.norm() * pixel_pitch_rad);
     if (e_norm <= sampling) continue;
     // Where the visibility crop left out nearer samples of the model (a patch judged hidden), the offset to
     // the nearest visible one is the crop's, not the pose's: only where the model really ends is it
