@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "ardsim_pose/pose_types.h"
 
@@ -43,8 +44,10 @@ class FixedMethodSelector : public MethodSelector {
 };
 
 struct EstimatorOptions {
-  bool median_filter = false;  // median of the last median_window estimates (as in the study): smoother, lags
-  int median_window = 5;       // frames, odd
+  // Median of the last median_window estimates (as in the study), each first carried forward to the frame's
+  // stamp at the window's velocity: smoother, without lagging a steady motion.
+  bool median_filter = false;
+  int median_window = 5;  // frames, odd
   double velocity_smoothing =
       0.5;  // weight of the new difference in the velocity's exponential smoothing, 0..1
   double max_prediction_gap_s = 2.0;  // a longer gap since the last good estimate: predict without velocity
@@ -72,7 +75,9 @@ class PoseEstimator {
 
  private:
   void updateVelocity(const Eigen::Isometry3d& T, EstimateStatus status, double stamp_s);
-  Eigen::Isometry3d medianOf(const std::deque<Eigen::Isometry3d>& poses) const;
+  // The filtered pose at stamp_s from (stamp, raw estimate) pairs.
+  Eigen::Isometry3d medianOf(const std::deque<std::pair<double, Eigen::Isometry3d>>& recent,
+                             double stamp_s) const;
 
   EstimatorOptions options_;
   Methods methods_;
@@ -87,7 +92,7 @@ class PoseEstimator {
   bool velocity_valid_ = false;
   PoseResult previous_;
   bool have_previous_ = false;
-  std::deque<Eigen::Isometry3d> recent_;  // good raw estimates, for the median filter
+  std::deque<std::pair<double, Eigen::Isometry3d>> recent_;  // (stamp s, good raw estimate), for the filter
 };
 
 }  // namespace ardsim_pose
