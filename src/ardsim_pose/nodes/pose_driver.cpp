@@ -45,6 +45,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   std::string target = ardsim_description::targetKindName(c.target);
   read(nh, "target", &target);
   validated("target: ", [&] { c.target = ardsim_description::parseTargetKind(target); });
+  applyTargetDefaults(&c);  // the parameters below override them
   read(nh, "method", &c.method);
   read(nh, "width", &c.sensor.width);
   read(nh, "height", &c.sensor.height);

@@ -22,6 +22,13 @@ void validate(const PoseConfig& c) {
   validate(c.estimator);
 }
 
+void applyTargetDefaults(PoseConfig* config) {
+  const PoseConfig defaults;
+  const bool hubble = config->target == ardsim_description::TargetKind::kHubble;
+  config->model.spacing_at_port_m = hubble ? 0.015 : defaults.model.spacing_at_port_m;
+  config->icp.max_points = hubble ? 2500 : defaults.icp.max_points;
+}
+
 std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::TargetKind kind,
                                                           const ReferenceModelOptions& options) {
   return std::make_shared<const ReferenceModel>(

@@ -75,6 +75,7 @@ Arguments parseArguments(int argc, char** argv) {
     }
   }
   if (a.dataset.empty()) throw std::invalid_argument("--dataset is required");
+  ardsim_pose::applyTargetDefaults(&a.config);
   return a;
 }
 

@@ -183,6 +183,7 @@ TEST_F(LostFrames, AnotherObjectIsLost) {
 TEST(HubbleEndOn, APredictionOffAcrossTheBoresightIsCorrected) {
   PoseConfig config;
   config.target = TargetKind::kHubble;
+  applyTargetDefaults(&config);
   const std::shared_ptr<const ReferenceModel> model = buildReferenceModel(TargetKind::kHubble, config.model);
   ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
   simulator.setTarget(ardsim_description::buildHubble());
@@ -263,6 +264,7 @@ TEST(IssCloseApproach, BoresightRotationHeldNearThePrediction) {
 TEST(HubbleApproach, TracksWithoutLosingAFrame) {
   PoseConfig config;
   config.target = TargetKind::kHubble;
+  applyTargetDefaults(&config);
   ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 1);
   simulator.setTarget(ardsim_description::buildHubble());
   std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
