@@ -395,7 +395,7 @@ int IcpTracker::nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, f
 }
 
 IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double gate, int max_iterations,
-                                        bool prune_unmatched, int stride) {
+                                        bool tracking, int stride) {
   Alignment a;
   a.T = T_start;
   const auto selectActive = [&](int every) {
@@ -434,7 +434,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       if (j < 0) continue;
       // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
       // solar arrays, background returns. Searching for it again each iteration is the costliest query.
-      if (prune_unmatched) active_[kept++] = k;
+      if (tracking) active_[kept++] = k;
       Correspondence c;
       c.scan = s.cast<double>();
       c.model = T * model_->points()[j].cast<double>();
@@ -444,7 +444,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       c.spacing = model_->spacing()[j];
       correspondences_.push_back(c);
     }
-    if (prune_unmatched) active_.resize(kept);
+    if (tracking) active_.resize(kept);
     if (static_cast<int>(correspondences_.size()) < options_.min_points) {
       a.failure = "too few correspondences with the model: " + std::to_string(correspondences_.size()) +
                   " < " + std::to_string(options_.min_points);
@@ -501,7 +501,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       // sigma squared over the prior's). Without it the rotation wandered 10-20 deg a frame on noise there.
       Eigen::Matrix<double, 6, 6> H_solve = a.H;
       Eigen::Matrix<double, 6, 1> g_solve = g;
-      if (prune_unmatched && options_.boresight_prior_deg > 0.0 &&
+      if (tracking && options_.boresight_prior_deg > 0.0 &&
           boresight_information < 10.0 * options_.degraded_condition) {
         const double prior_rad = options_.boresight_prior_deg * M_PI / 180.0;
         const double information = sigma * sigma / (prior_rad * prior_rad);

@@ -118,8 +118,9 @@ class IcpTracker : public PoseMethod {
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   };
-  // Uses every stride-th scan point.
-  Alignment align(const Eigen::Isometry3d& T_start, double gate_m, int max_iterations, bool prune_unmatched,
+  // Uses every stride-th scan point. tracking: from a prediction (T_start): scan points left unmatched are
+  // not searched again, and a barely observed boresight rotation is held near T_start (boresight_prior_deg).
+  Alignment align(const Eigen::Isometry3d& T_start, double gate_m, int max_iterations, bool tracking,
                   int stride);
   Alignment acquire(const Eigen::Isometry3d& T_prior);
   // Of the hypotheses, each aligned for search_iterations, the one that explains most scan points.
