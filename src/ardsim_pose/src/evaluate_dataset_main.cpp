@@ -8,6 +8,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ardsim_pose/dataset.h"
@@ -22,7 +23,9 @@ constexpr const char* kUsage =
     "                        [--target iss|hubble] [--frame-period-s S] [--median-filter on|off]\n"
     "Runs the estimator over DIR/frame_*.pcd in the order of DIR/truth.csv; writes DIR/estimates.csv.\n"
     "--init truth: the first frame starts from its truth; perturbed (default): from the coarse prior\n"
-    "(truth turned 10 deg about the port, port range 10 % off, 2 m lateral; directions seeded by --seed).";
+    "(truth turned 10 deg about the port, port range 10 % off, 2 m lateral; directions seeded by --seed).\n"
+    "Prints per range band (lidar to port) the position error of the port and the attitude error: the whole\n"
+    "rotation (att), its part across the boresight (tilt) and about it (bore); LOST frames are left out.";
 
 struct Arguments {
   std::string dataset;
@@ -80,8 +83,8 @@ Arguments parseArguments(int argc, char** argv) {
 }
 
 struct Band {
-  double min_m, max_m;
-  std::vector<double> pos, att, ms;
+  double min_m = 0.0, max_m = 0.0;
+  std::vector<double> pos, att, tilt, boresight, ms;  // tilt: across the boresight; boresight: about it
   int frames = 0, lost = 0;
 };
 
@@ -131,9 +134,16 @@ int run(int argc, char** argv) {
   csv << "frame,stamp_s,status,x,y,z,qx,qy,qz,qw,range_m,pos_err_m,att_err_deg,fit_rms_m,inlier_fraction,"
          "points_used,iterations,ms,reason\n";
   csv.precision(10);
-  std::vector<Band> bands = {{0, 10, {}, {}, {}},  {10, 20, {}, {}, {}}, {20, 30, {}, {}, {}},
-                             {30, 50, {}, {}, {}}, {50, 75, {}, {}, {}}, {75, 1e9, {}, {}, {}}};
-  Band all{0, 1e9, {}, {}, {}};
+  std::vector<Band> bands;
+  for (const auto& [min_m, max_m] :
+       {std::pair{0.0, 10.0}, {10.0, 20.0}, {20.0, 30.0}, {30.0, 50.0}, {50.0, 75.0}, {75.0, 1e9}}) {
+    bands.emplace_back();
+    bands.back().min_m = min_m;
+    bands.back().max_m = max_m;
+  }
+  Band all;
+  all.min_m = 0.0;
+  all.max_m = 1e9;
   for (std::size_t k = 0; k < truth.size(); ++k) {
     const double stamp_s = static_cast<double>(k) * args.frame_period_s;
     const ardsim_pose::OrganizedCloud cloud =
@@ -154,6 +164,8 @@ int run(int argc, char** argv) {
       } else {
         band->pos.push_back(pos);
         band->att.push_back(att_deg);
+        band->tilt.push_back(e.attitude_error_rad.head<2>().norm() * 180.0 / M_PI);
+        band->boresight.push_back(std::abs(e.attitude_error_rad.z()) * 180.0 / M_PI);
       }
     }
     const Eigen::Quaterniond q(out.result.T_lidar_target.linear());
@@ -164,8 +176,8 @@ int run(int argc, char** argv) {
         << out.result.inlier_fraction << ',' << out.result.points_used << ',' << out.result.iterations << ','
         << out.compute_ms << ",\"" << out.result.reason << "\"\n";
   }
-  std::printf("%-12s %6s %5s %10s %10s %11s %11s %8s\n", "range_m", "frames", "lost", "pos_rms_m",
-              "pos_max_m", "att_rms_deg", "att_max_deg", "ms_med");
+  std::printf("%-12s %6s %5s %10s %10s %11s %11s %12s %12s %8s\n", "range_m", "frames", "lost", "pos_rms_m",
+              "pos_max_m", "att_rms_deg", "att_max_deg", "tilt_rms_deg", "bore_rms_deg", "ms_med");
   for (const Band& b : bands) {
     if (b.frames == 0) continue;
     char label[32];
@@ -173,8 +185,9 @@ int run(int argc, char** argv) {
       std::snprintf(label, sizeof(label), ">= %.0f", b.min_m);
     else
       std::snprintf(label, sizeof(label), "%.0f-%.0f", b.min_m, b.max_m);
-    std::printf("%-12s %6d %5d %10.4f %10.4f %11.4f %11.4f %8.2f\n", label, b.frames, b.lost, rms(b.pos),
-                maxOf(b.pos), rms(b.att), maxOf(b.att), medianOf(b.ms));
+    std::printf("%-12s %6d %5d %10.4f %10.4f %11.4f %11.4f %12.4f %12.4f %8.2f\n", label, b.frames, b.lost,
+                rms(b.pos), maxOf(b.pos), rms(b.att), maxOf(b.att), rms(b.tilt), rms(b.boresight),
+                medianOf(b.ms));
   }
   std::printf(
       "summary frames=%d lost=%d pos_rms_m=%.4f pos_max_m=%.4f att_rms_deg=%.4f att_max_deg=%.4f "
