@@ -28,6 +28,34 @@ double nearestBranch(double base, double period, double target) {
   return base + period * std::round(wrapPi(target - base) / period);
 }
 
+// A pixel of a three-fold feature (a guide petal, a reflector disc) at an angle about the port's axis.
+struct AnglePoint {
+  double angle;
+  std::complex<double>
+      unit3;    // at 3 x angle (half a turn on for the reflectors), for the sums (a sincos each)
+  bool border;  // touches the image border
+};
+
+// Per feature (three, 120 deg apart, the first at first_rad): the sum of unit3, the count and whether any
+// touches the border, of the points nearest to it and within half_width_rad of it.
+struct PerFeature {
+  std::array<std::complex<double>, 3> sum{};
+  std::array<int, 3> count{};
+  std::array<bool, 3> border{};
+};
+PerFeature perFeature(const std::vector<AnglePoint>& points, double first_rad, double half_width_rad) {
+  PerFeature f;
+  for (const AnglePoint& p : points) {
+    const int branch = static_cast<int>(std::lround(wrapPi(p.angle - first_rad) / (2.0 * M_PI / 3.0)));
+    if (std::abs(wrapPi(p.angle - first_rad - branch * 2.0 * M_PI / 3.0)) > half_width_rad) continue;
+    const int k = ((branch % 3) + 3) % 3;
+    f.sum[k] += p.unit3;
+    ++f.count[k];
+    f.border[k] = f.border[k] || p.border;
+  }
+  return f;
+}
+
 // Largest empty gap (rad) between sorted angles on the circle; 2 pi when there are none.
 double largestGap(std::vector<double>& angles) {
   if (angles.empty()) return 2.0 * M_PI;
@@ -611,12 +639,7 @@ double AdapterFitter::reflectorAngle(const PreparedFrame& frame, const Eigen::Is
   const double face_min = g.reflector_face_x_m - 0.025, face_max = g.reflector_face_x_m + 0.1;
   const double radius_min = g.reflector_radius_m - g.reflector_disc_radius_m - 0.02;
   const double radius_max = g.reflector_radius_m + g.reflector_disc_radius_m + 0.02;
-  struct DiscPoint {
-    double angle;
-    std::complex<double> unit3;
-    bool border;
-  };
-  std::vector<DiscPoint> points;
+  std::vector<AnglePoint> points;
   std::complex<double> total = 0.0;
   const double along_min = d + face_min - 1e-6, along_max = d + face_max + 1e-6;
   const int pixels = frame.width * frame.height;
@@ -638,24 +661,14 @@ double AdapterFitter::reflectorAngle(const PreparedFrame& frame, const Eigen::Is
   const double first_disc = std::arg(total) / 3.0 + M_PI / 3.0;
   const double half_width =
       std::asin(std::min(1.0, (g.reflector_disc_radius_m + 0.04) / g.reflector_radius_m));
-  std::array<std::complex<double>, 3> per_disc{};
-  std::array<int, 3> per_disc_count{};
-  std::array<bool, 3> per_disc_border{};
-  for (const DiscPoint& p : points) {
-    const long branch = std::lround(wrapPi(p.angle - first_disc) / (2.0 * M_PI / 3.0));
-    if (std::abs(wrapPi(p.angle - first_disc - branch * 2.0 * M_PI / 3.0)) > half_width) continue;
-    const int k = static_cast<int>(((branch % 3) + 3) % 3);
-    per_disc[k] += p.unit3;
-    ++per_disc_count[k];
-    per_disc_border[k] = per_disc_border[k] || p.border;
-  }
+  const PerFeature per_disc = perFeature(points, first_disc, half_width);
   std::complex<double> sum = 0.0;
   int discs = 0, count = 0;
   for (int k = 0; k < 3; ++k) {
-    if (per_disc_border[k] || per_disc_count[k] < options_.min_reflector_points) continue;
-    sum += per_disc[k] / static_cast<double>(per_disc_count[k]);  // each disc counts once
+    if (per_disc.border[k] || per_disc.count[k] < options_.min_reflector_points) continue;
+    sum += per_disc.sum[k] / static_cast<double>(per_disc.count[k]);  // each disc counts once
     ++discs;
-    count += per_disc_count[k];
+    count += per_disc.count[k];
   }
   report->reflector_points = count;
   report->reflectors = discs >= 2 && std::abs(sum) >= options_.min_resultant * discs;
@@ -712,11 +725,6 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   T_plane.linear() = portRotation(r.n, 0.0);
   T_plane.translation() = r.centre;
   const Eigen::Isometry3d T_port0_lidar = T_plane.inverse();
-  struct AnglePoint {
-    double angle;
-    std::complex<double> unit3;  // at 3 x angle, kept for the per-petal sums (a sincos each)
-    bool border;
-  };
   std::vector<AnglePoint> petal_points;
   std::complex<double> petal_sum = 0.0;
   // q.x() below is n.p - d up to rounding, and the last round left n.p of every pixel in along_: most pixels
@@ -735,23 +743,14 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
     }
   }
   // Per petal (nearest branch of the first estimate), drop those touching the border, then the mean again.
-  std::array<std::complex<double>, 3> per_petal{};
-  std::array<int, 3> per_petal_count{};
-  std::array<bool, 3> per_petal_border{};
-  const double petal_first = std::arg(petal_sum) / 3.0;
-  for (const AnglePoint& a : petal_points) {
-    const int k =
-        ((static_cast<int>(std::lround(wrapPi(a.angle - petal_first) / (2.0 * M_PI / 3.0))) % 3) + 3) % 3;
-    per_petal[k] += a.unit3;
-    ++per_petal_count[k];
-    per_petal_border[k] = per_petal_border[k] || a.border;
-  }
+  const PerFeature per_petal =
+      perFeature(petal_points, std::arg(petal_sum) / 3.0, std::numeric_limits<double>::infinity());
   petal_sum = 0.0;
   int petal_count = 0;
   for (int k = 0; k < 3; ++k) {
-    if (per_petal_border[k]) continue;
-    petal_sum += per_petal[k];
-    petal_count += per_petal_count[k];
+    if (per_petal.border[k]) continue;
+    petal_sum += per_petal.sum[k];
+    petal_count += per_petal.count[k];
   }
   r.report.petal_points = petal_count;
   const double prior_angle = boresightAngle(T_lidar_port_prior.linear());
