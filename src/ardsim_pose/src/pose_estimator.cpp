@@ -100,27 +100,31 @@ Eigen::Isometry3d PoseEstimator::medianOf(const std::deque<std::pair<double, Eig
   // frame). Then per axis: the median position, and the median rotation vector relative to the newest
   // attitude. Fewer than three: no velocity to trust, and a median of two is their mean: the newest as it is.
   if (recent.size() < 3) return recent.back().second;
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero(), angular_velocity = Eigen::Vector3d::Zero();
-  for (int axis = 0; axis < 3; ++axis) {
-    std::vector<double> linear_medians, angular_medians;
-    for (std::size_t i = 0; i < recent.size(); ++i) {
-      std::vector<double> linear, angular;
-      for (std::size_t j = 0; j < recent.size(); ++j) {
-        const double dt = recent[j].first - recent[i].first;
-        if (j == i || !(std::abs(dt) > 0.0)) continue;
-        const Eigen::Isometry3d& a = recent[i].second;
-        const Eigen::Isometry3d& b = recent[j].second;
-        linear.push_back((b.translation()[axis] - a.translation()[axis]) / dt);
-        angular.push_back(rotationVector(b.linear() * a.linear().transpose())[axis] / dt);
-      }
-      if (linear.empty()) continue;
-      linear_medians.push_back(medianOfValues(linear));
-      angular_medians.push_back(medianOfValues(angular));
+  // The pairs' velocities once (row i: from estimate i to each other one), then the medians per axis.
+  std::vector<std::vector<Eigen::Matrix<double, 6, 1>>> pair_velocities(recent.size());
+  for (std::size_t i = 0; i < recent.size(); ++i) {
+    for (std::size_t j = 0; j < recent.size(); ++j) {
+      const double dt = recent[j].first - recent[i].first;
+      if (j == i || !(std::abs(dt) > 0.0)) continue;
+      const Eigen::Isometry3d& a = recent[i].second;
+      const Eigen::Isometry3d& b = recent[j].second;
+      Eigen::Matrix<double, 6, 1> v;
+      v << (b.translation() - a.translation()) / dt, rotationVector(b.linear() * a.linear().transpose()) / dt;
+      pair_velocities[i].push_back(v);
     }
-    if (linear_medians.empty()) continue;
-    velocity[axis] = medianOfValues(linear_medians);
-    angular_velocity[axis] = medianOfValues(angular_medians);
   }
+  Eigen::Matrix<double, 6, 1> velocities = Eigen::Matrix<double, 6, 1>::Zero();  // linear, angular
+  for (int axis = 0; axis < 6; ++axis) {
+    std::vector<double> row_medians;
+    for (const auto& row : pair_velocities) {
+      if (row.empty()) continue;
+      std::vector<double> values;
+      for (const Eigen::Matrix<double, 6, 1>& v : row) values.push_back(v[axis]);
+      row_medians.push_back(medianOfValues(values));
+    }
+    if (!row_medians.empty()) velocities[axis] = medianOfValues(row_medians);
+  }
+  const Eigen::Vector3d velocity = velocities.head<3>(), angular_velocity = velocities.tail<3>();
   std::vector<Eigen::Isometry3d> poses;
   for (const auto& [t, T] : recent) {
     Eigen::Isometry3d moved = T;
