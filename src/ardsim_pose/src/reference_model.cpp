@@ -326,6 +326,7 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
       count += static_cast<int>(patch.end - patch.begin);
     }
   }
+  nearest_depth_ = *std::min_element(depth_.begin(), depth_.end());
   model_depth_.assign(static_cast<std::size_t>(grid_width_) * grid_height_, inf);
   for (int y = 0; y < grid_height_; ++y)
     for (int x = 0; x < grid_width_; ++x)

@@ -3,6 +3,7 @@
 // that say TRACKING, DEGRADED or LOST, and the covariance from the final normal equations. ROS-free.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -98,7 +99,7 @@ class IcpTracker : public PoseMethod {
   // Of the last frame: fraction of the cells where the model is predicted that the scan confirms.
   double lastCoverage() const { return coverage_; }
   // Of the last frame: the visibility mask and the scan subsample (lidar frame), for benchmarks and tests.
-  const std::vector<std::uint8_t>& lastVisible() const { return visible_; }
+  const std::vector<std::uint8_t>& lastVisible() const { return slots_[current_].visible; }
   const std::vector<Eigen::Vector3f>& lastScanPoints() const { return scan_; }
   const ReferenceModel& model() const { return *model_; }
   const IcpOptions& options() const { return options_; }
@@ -131,17 +132,21 @@ class IcpTracker : public PoseMethod {
   bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
   double coverage() const;
   void alignRange(Eigen::Isometry3d* T);
-  // visibility_.predict at T into visible_, unless the last prediction was at exactly T or (tolerance_px
-  // > 0) at a pose that puts every scan point within tolerance_px of where T puts it.
+  // Makes current a visibility prediction at T: one of the two kept (the last two made) when it was made at
+  // exactly T or (tolerance_px > 0) at a pose that puts every visible model point within tolerance_px of
+  // where T puts it, else a new one in place of the older.
   void predictVisibility(const Eigen::Isometry3d& T, double tolerance_px = 0.0);
+  const VisibilityPredictor& visibility() const { return slots_[current_].predictor; }
+  const std::vector<std::uint8_t>& visible() const { return slots_[current_].visible; }
   // The norm (m; rotations times the correspondences' lever arm) of the move from T_from to T_to in the weak
   // directions of the lever-scaled normal equations about centre (eigen: of their first five unknowns).
   double weakPart(const Eigen::Isometry3d& T_from, const Eigen::Isometry3d& T_to,
                   const Eigen::Vector3d& centre,
                   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>& eigen,
                   double largest) const;
-  // An upper bound on how far, in pixels, a scan point moves in the image between poses a and b.
-  double imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) const;
+  // An upper bound on how far, in pixels, a model point at a depth of at least near_m at pose a moves in the
+  // image between poses a and b.
+  double imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b, double near_m) const;
   // H with its rotation rows and columns scaled by the correspondences' lever arm about centre.
   Eigen::Matrix<double, 6, 6> leverScaled(const Eigen::Matrix<double, 6, 6>& H,
                                           const Eigen::Vector3d& centre) const;
@@ -171,14 +176,22 @@ class IcpTracker : public PoseMethod {
   std::shared_ptr<const ReferenceModel> model_;
   ardsim_lidar::Intrinsics intrinsics_;
   IcpOptions options_;
-  VisibilityPredictor visibility_;
+  // The last two visibility predictions: tracking returns to the pose of the frame before after a
+  // correction (a prediction off by a few pixels, then the estimate back near the last one).
+  struct VisibilitySlot {
+    VisibilitySlot(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options)
+        : predictor(intrinsics, options) {}
+    VisibilityPredictor predictor;
+    std::vector<std::uint8_t> visible;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    bool valid = false;
+  };
+  std::array<VisibilitySlot, 2> slots_;
+  int current_ = 0;
   bool acquiring_ = true;
   std::vector<std::pair<double, Eigen::Isometry3d>>
       acquired_;  // (stamp s, pose) of the last acquisition frames
   double coverage_ = 0.0;
-  std::vector<std::uint8_t> visible_;
-  Eigen::Isometry3d visibility_pose_ = Eigen::Isometry3d::Identity();  // pose of the last prediction
-  bool visibility_valid_ = false;
   std::vector<Eigen::Vector3f> scan_;
   std::vector<int> active_;  // indices of the scan_ points still searched for
   // Per scan_ point, the visible model points in a ball around where it was last searched (target frame):
@@ -202,7 +215,6 @@ class IcpTracker : public PoseMethod {
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
   std::vector<std::uint8_t> silhouette_;       // see markSilhouette
   std::vector<float> scan_depth_;
-  double scan_near_m_ = 1.0;  // depth of the nearest return of the frame
   struct Correspondence {
     Eigen::Vector3d scan;    // lidar frame
     Eigen::Vector3d model;   // lidar frame, at the current pose

@@ -118,6 +118,8 @@ class VisibilityPredictor {
   int cellPx() const { return options_.cell_px; }
   // Nearest predicted model depth (lidar z, m) per cell from the last predict(); +inf where no model surface.
   const std::vector<float>& modelDepth() const { return model_depth_; }
+  // Depth (lidar z, m) of the nearest predicted model surface, margin included; +inf where none.
+  float nearestDepth() const { return nearest_depth_; }
   // Cell of a pixel (inside the image).
   int cellOfPixel(int u, int v) const { return (v / options_.cell_px) * grid_width_ + u / options_.cell_px; }
 
@@ -131,6 +133,7 @@ class VisibilityPredictor {
   int padded_height_ = 0;
   std::vector<float> depth_;        // padded grid
   std::vector<float> model_depth_;  // image grid
+  float nearest_depth_ = 0.0f;
   struct Candidate {
     std::uint32_t patch;
     std::int32_t cell;  // padded grid
