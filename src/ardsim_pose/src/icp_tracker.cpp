@@ -208,7 +208,8 @@ bool IcpTracker::boresightObserved(const Eigen::Matrix<double, 6, 6>& H_scaled, 
 }
 
 void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest,
-                                    const Alignment& a, double gate_m, Eigen::Matrix<double, 6, 1>* delta,
+                                    const Alignment& a, double gate_m, bool with_planes,
+                                    Eigen::Matrix<double, 6, 1>* delta,
                                     Eigen::Matrix<double, 6, 1>* weak_step) const {
   // The plane fit's directions (lever-scaled) with less than weak_direction_condition of its largest
   // information: the step there comes from the tangential offsets instead (none: held). Among the first five
@@ -260,11 +261,27 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
   const Eigen::MatrixXd D = scale.asDiagonal() * U;  // the same directions, unscaled
   // The plane step's part in those directions, removed (in scaled coordinates, where U is orthonormal).
   Eigen::Matrix<double, 6, 1> y = delta->cwiseQuotient(scale);
-  y -= U * (U.transpose() * y);
+  const Eigen::VectorXd y_weak = U.transpose() * y;
+  y -= U * y_weak;
   *delta = y.cwiseProduct(scale);
-  const Eigen::MatrixXd H_weak = D.transpose() * H_tangential * D;
-  const Eigen::VectorXd z = H_weak.ldlt().solve(D.transpose() * g_tangential);
-  if (z.allFinite() && H_weak.trace() > 0.0) {
+  Eigen::MatrixXd H_weak = D.transpose() * H_tangential * D;
+  const double tangential_trace = H_weak.trace();
+  Eigen::VectorXd g_weak = D.transpose() * g_tangential;
+  if (with_planes) {
+    // The plane fit's own step there (y_weak, information its eigenvalue) weighs in with the offsets': from
+    // 0.2 m off at 30 m the offsets alone crept 1-2 cm an iteration and a benchmark frame stopped 6.6 cm
+    // short after 15 (with both: 0.8 mm).
+    for (int k = 0; k < weak; ++k) {
+      H_weak(k, k) += eigen.eigenvalues()(k);
+      g_weak(k) += eigen.eigenvalues()(k) * y_weak(k);
+    }
+  }
+  const Eigen::VectorXd z = H_weak.ldlt().solve(g_weak);
+  // Less information along the weak directions than a third of one fully weighted offset is a stray point (a
+  // mixed pixel past a rim), not a rim: held. (One such, 0.39 m off, slid an ISS frame at 7 m by 0.3 m. The
+  // third from the datasets: with a whole one, an acquisition frame of hubble_hold at 50 m went 5.5 -> 8.8
+  // cm.)
+  if (z.allFinite() && tangential_trace >= 0.3) {
     *weak_step = D * z;
     // A few offsets that barely constrain a weak direction make their normal equations near singular: the
     // step then ran to hundreds of metres (Hubble end-on, 27 m). A step (lever-scaled) beyond the
@@ -506,6 +523,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
             .eigenvalues()(5);
     const double boresight_information = boresightInformation(H_scaled, largest);
+    const bool boresight_well_observed = boresight_information >= 10.0 * options_.degraded_condition;
     if (boresight_information > options_.degraded_condition) {
       // Tracking, with the boresight rotation barely observed (below 10 x the observed limit: Hubble's
       // bulkhead end-on, the ISS's docking adapter filling the view; the ISS from 12 m out is above): a prior
@@ -513,8 +531,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       // sigma squared over the prior's). Without it the rotation wandered 10-20 deg a frame on noise there.
       Eigen::Matrix<double, 6, 6> H_solve = a.H;
       Eigen::Matrix<double, 6, 1> g_solve = g;
-      if (tracking && options_.boresight_prior_deg > 0.0 &&
-          boresight_information < 10.0 * options_.degraded_condition) {
+      if (tracking && options_.boresight_prior_deg > 0.0 && !boresight_well_observed) {
         const double prior_rad = options_.boresight_prior_deg * M_PI / 180.0;
         const double information = sigma * sigma / (prior_rad * prior_rad);
         const Eigen::AngleAxisd turn(T.linear() * T_start.linear().transpose());
@@ -528,7 +545,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     // The weak directions' part of the step (from the tangential offsets), judged on its own below.
     Eigen::Matrix<double, 6, 1> weak_step = Eigen::Matrix<double, 6, 1>::Zero();
     if (options_.weak_direction_condition > 0.0)
-      stepWeakDirections(H_scaled, largest, a, gate, &delta, &weak_step);
+      stepWeakDirections(H_scaled, largest, a, gate, boresight_well_observed, &delta, &weak_step);
     if (!delta.allFinite()) {
       a.failure = "diverged: singular normal equations";
       return a;

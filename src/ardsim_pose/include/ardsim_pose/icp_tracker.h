@@ -154,10 +154,12 @@ class IcpTracker : public PoseMethod {
   Eigen::Matrix<double, 6, 1> leverScale(const Eigen::Vector3d& centre) const;
   // Replaces delta's part in the weak directions of H_scaled (see weak_direction_condition) by the
   // Gauss-Newton step of the tangential offsets' normal equations there (also into weak_step), from the
-  // correspondences and the Tukey limit and centre of the iteration a; a step beyond gate_m (a near-singular
+  // correspondences and the Tukey limit and centre of the iteration a, with_planes: together with the plane
+  // fit's own (where the boresight rotation is well observed; where it is barely, the planes' weak
+  // directions carried Hubble's roll 12 deg off over its approach); a step beyond gate_m (a near-singular
   // solve) is cut back.
   void stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest, const Alignment& a,
-                          double gate_m, Eigen::Matrix<double, 6, 1>* delta,
+                          double gate_m, bool with_planes, Eigen::Matrix<double, 6, 1>* delta,
                           Eigen::Matrix<double, 6, 1>* weak_step) const;
   // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the
   // boresight: its information with the other five free, over the largest eigenvalue, above
