@@ -1,7 +1,8 @@
 // ICP on frames rendered in-process by the lidar core: acquisition from the coarse prior at 100, 30 and 10 m
 // with and without noise, within a few frames, to the accuracy goals, never a wrong pose as TRACKING;
 // solar arrays turned away from the model, and filling the view at 250 m; LOST (not a wrong pose) on an empty
-// frame, a garbage frame and a frame of another object.
+// frame, a garbage frame and a frame of another object; the benchmark's 0.2 m-off guesses at 30 m corrected
+// along a weakly observed direction.
 #include <algorithm>
 #include <memory>
 #include <random>
@@ -182,6 +183,36 @@ TEST_F(LostFrames, AnotherObjectIsLost) {
 // tracker, tracking, is given predictions 0.15 m off across the boresight: it must come back to within 5 cm
 // (measured 1.8-3.7 cm; point-to-plane alone stayed 0.08-0.58 m off, once reported TRACKING at 0.15 m) and
 // never report TRACKING beyond the 2 cm goal.
+// The benchmark's frames at 30 m (bench_pose_icp): tracking, each frame from the truth turned 0.5 deg and
+// moved 0.2 m across the line of sight. The view (the docking adapter on Harmony's end) has a weakly observed
+// direction: with the tangential offsets alone there, one of these frames stopped 6.6 cm short after the 15
+// iterations (DEGRADED); with the plane fit's own step combined, every frame ends within millimetres.
+TEST_F(RenderedIcp, WeakDirectionFromAGuessOffAcrossTheLineOfSight) {
+  PoseConfig config;
+  IcpTracker tracker(iss_model_, ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
+  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
+  simulator.setTarget(ardsim_description::buildIss());
+  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kIss);
+  ardsim_lidar::LidarFrame frame;
+  std::vector<OrganizedCloud> clouds;
+  std::vector<Eigen::Isometry3d> truths;
+  for (int k = 0; k < 8; ++k) {
+    truths.push_back(dockingAxisPose(TargetKind::kIss, 29.0 - 0.01 * k));
+    simulator.simulate(truths.back(), static_cast<std::uint64_t>(k), &frame);
+    clouds.push_back(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
+  }
+  ASSERT_EQ(tracker.estimate(clouds[0], truths[0]).status, EstimateStatus::kTracking);
+  for (int k = 0; k < 8; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const Eigen::Isometry3d guess =
+        perturbPrior(truths[k], T_target_port, PriorPerturbation{0.5, 0.0, 0.2}, 100 + k);
+    const PoseResult result = tracker.estimate(clouds[k], guess);
+    EXPECT_EQ(result.status, EstimateStatus::kTracking) << result.reason;
+    const PoseErrorValue e = poseError(result.T_lidar_target, truths[k], T_target_port);
+    EXPECT_LT(e.port_position_error_m.norm(), 0.01);
+  }
+}
+
 TEST(HubbleEndOn, APredictionOffAcrossTheBoresightIsCorrected) {
   PoseConfig config;
   config.target = TargetKind::kHubble;
