@@ -22,7 +22,10 @@ CONTACT_KEYS = ["closing_speed_mps", "lateral_misalignment_m", "angular_misalign
 
 class DockShort(unittest.TestCase):
     def test_docks_and_leaves_a_complete_run_directory(self):
-        out, s = run_scenario(self, os.path.join(SCENARIOS, "dock_15m.yaml"), "rviz:=none", "pose_source:=truth")
+        # At most 10x real time: unthrottled (RTF ~28, ~70 MB/s of 128 x 128 clouds) the recorder, outside the
+        # lockstep, lost half the estimates once while other jobs loaded the machine.
+        out, s = run_scenario(self, os.path.join(SCENARIOS, "dock_15m.yaml"), "rviz:=none", "pose_source:=truth",
+                              "real_time_factor:=10")
         for key in SUMMARY_KEYS:
             self.assertIn(key, s)
         self.assertTrue(s["docked"], "outcome %s: %s" % (s["outcome"], s["reason"]))

@@ -277,18 +277,21 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
     }
   }
   const Eigen::VectorXd z = H_weak.ldlt().solve(g_weak);
-  // Less information along the weak directions than a third of one fully weighted offset is a stray point (a
-  // mixed pixel past a rim), not a rim: held. (One such, 0.39 m off, slid an ISS frame at 7 m by 0.3 m. The
-  // third from the datasets: with a whole one, an acquisition frame of hubble_hold at 50 m went 5.5 -> 8.8
-  // cm.)
-  if (z.allFinite() && tangential_trace >= 0.3) {
+  if (z.allFinite() && tangential_trace > 0.0) {
     *weak_step = D * z;
     // A few offsets that barely constrain a weak direction make their normal equations near singular: the
     // step then ran to hundreds of metres (Hubble end-on, 27 m). A step (lever-scaled) beyond the
     // correspondence gate is that, not data: it is cut to the largest offset (closing the offsets never
-    // takes more).
+    // takes more), or held where the offsets weigh less than a third of one fully weighted offset: a stray
+    // point (a mixed pixel past a rim), not a rim (one such, 0.39 m off, slid an ISS frame at 7 m by 0.3 m).
     const double size_m = weak_step->cwiseQuotient(scale).norm();
-    if (size_m > gate_m) *weak_step *= largest_offset_m / size_m;
+    if (size_m > gate_m) {
+      if (tangential_trace < 0.3) {
+        weak_step->setZero();
+        return;
+      }
+      *weak_step *= largest_offset_m / size_m;
+    }
     *delta += *weak_step;
   }
 }
@@ -380,7 +383,7 @@ double IcpTracker::silhouetteInlierFraction(double limit_m) {
   return on > 0 ? static_cast<double>(inliers) / on : 0.0;
 }
 
-void IcpTracker::gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isometry3d& T, double margin_px) {
+void IcpTracker::gateToSilhouette(const Eigen::Isometry3d& T, double margin_px) {
   gated_ = valid_;
   if (!(margin_px > 0.0)) return;
   predictVisibility(T);
@@ -388,9 +391,8 @@ void IcpTracker::gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isom
   if (r >= std::max(visibility().gridWidth(), visibility().gridHeight())) return;
   markSilhouette(r);
   gated_.clear();
-  for (int i : valid_) {
-    if (silhouette_[visibility().cellOfPixel(i % cloud.width, i / cloud.width)]) gated_.push_back(i);
-  }
+  for (std::size_t k = 0; k < valid_.size(); ++k)
+    if (silhouette_[valid_cells_[k]]) gated_.push_back(valid_[k]);
   if (static_cast<int>(gated_.size()) < options_.min_points) gated_ = valid_;
 }
 
@@ -711,16 +713,22 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
 
   // Valid returns, and the nearest return per visibility cell (for the coverage check).
   valid_.clear();
+  valid_cells_.clear();
   scan_depth_.assign(static_cast<std::size_t>(visibility().gridWidth()) * visibility().gridHeight(),
                      std::numeric_limits<float>::infinity());
+  // The cell of each column once, not two integer divisions per pixel (0.1-0.2 ms a frame).
+  column_cells_.resize(cloud.width);
+  for (int u = 0; u < cloud.width; ++u) column_cells_[u] = visibility().cellOfPixel(u, 0);
   for (int v = 0; v < cloud.height; ++v) {
+    const int row_cell = visibility().cellOfPixel(0, v);
     for (int u = 0; u < cloud.width; ++u) {
       const int i = v * cloud.width + u;
       const Eigen::Vector3f& p = cloud.points[i];
       if (!p.allFinite() || !(p.z() > 0.0f)) continue;
+      const int cell = row_cell + column_cells_[u];
       valid_.push_back(i);
-      float& d = scan_depth_[visibility().cellOfPixel(u, v)];
-      d = std::min(d, p.z());
+      valid_cells_.push_back(cell);
+      scan_depth_[cell] = std::min(scan_depth_[cell], p.z());
     }
   }
   if (valid_.empty()) return lost("empty frame: no valid returns");
@@ -733,7 +741,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     const double range_m = std::max(1.0, T_predicted.translation().norm());
     margin_px += (options_.search_lateral_m + options_.search_offset_m) / range_m * intrinsics_.fx;
   }
-  gateToSilhouette(cloud, T_predicted, margin_px);
+  gateToSilhouette(T_predicted, margin_px);
   const std::size_t count = std::min<std::size_t>(gated_.size(), options_.max_points);
   scan_.reserve(count);
   for (std::size_t k = 0; k < count; ++k) scan_.push_back(cloud.points[gated_[k * gated_.size() / count]]);

@@ -173,7 +173,7 @@ class IcpTracker : public PoseMethod {
   // a predicted surface or next to one), the fraction within limit_m of the model in the last iteration.
   double silhouetteInlierFraction(double limit_m);
   // Keeps the valid_ pixels within margin_px of the model's silhouette at T (unless too few would remain).
-  void gateToSilhouette(const OrganizedCloud& cloud, const Eigen::Isometry3d& T, double margin_px);
+  void gateToSilhouette(const Eigen::Isometry3d& T, double margin_px);
 
   std::shared_ptr<const ReferenceModel> model_;
   ardsim_lidar::Intrinsics intrinsics_;
@@ -213,6 +213,8 @@ class IcpTracker : public PoseMethod {
   // when that answers exactly, else from the tree (and a new ball).
   int nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, float* distance_sq);
   std::vector<int> valid_;
+  std::vector<int> valid_cells_;               // their visibility cells
+  std::vector<int> column_cells_;              // scratch: the cell column of each pixel column
   std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
   std::vector<std::uint8_t> silhouette_;       // see markSilhouette
