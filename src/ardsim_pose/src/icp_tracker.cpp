@@ -321,6 +321,8 @@ double IcpTracker::imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isom
   // A point p moves by (R - 1) p + t from pose a to b: at most angle |p| + |t|, and |p| <= k z with k the
   // secant of the image corner's ray; over its depth z (at least near_m) in pixels. (Not the nearest
   // return's depth: background returns and hot pixels a metre away made every pose change "large".)
+  // A prediction with no model surface in view (infinite depth) serves no other pose.
+  if (!std::isfinite(near_m)) return std::numeric_limits<double>::infinity();
   const Eigen::Isometry3d moved = T_b * T_a.inverse();
   const double tan_x = (intrinsics_.cx + 0.5) / intrinsics_.fx,
                tan_y = (intrinsics_.cy + 0.5) / intrinsics_.fy;

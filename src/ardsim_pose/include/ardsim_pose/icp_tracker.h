@@ -157,7 +157,7 @@ class IcpTracker : public PoseMethod {
   // correspondences and the Tukey limit and centre of the iteration a, with_planes: together with the plane
   // fit's own (where the boresight rotation is well observed; where it is barely, the planes' weak
   // directions carried Hubble's roll 12 deg off over its approach); a step beyond gate_m (a near-singular
-  // solve) is cut back.
+  // solve) is cut back, or held where the offsets carry little information.
   void stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled, double largest, const Alignment& a,
                           double gate_m, bool with_planes, Eigen::Matrix<double, 6, 1>* delta,
                           Eigen::Matrix<double, 6, 1>* weak_step) const;
