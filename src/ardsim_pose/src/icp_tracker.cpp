@@ -140,6 +140,10 @@ IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model,
       slots_{VisibilitySlot(intrinsics, visibility), VisibilitySlot(intrinsics, visibility)} {
   validate(options_);
   if (!model_) throw std::invalid_argument("IcpTracker: no reference model");
+  // The cell of each pixel column once (the frame's width is the sensor's, checked per frame), not two
+  // integer divisions per pixel (0.1-0.2 ms a frame).
+  column_cells_.resize(intrinsics_.width);
+  for (int u = 0; u < intrinsics_.width; ++u) column_cells_[u] = this->visibility().cellOfPixel(u, 0);
 }
 
 double IcpTracker::coverage() const {
@@ -718,9 +722,6 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   valid_cells_.clear();
   scan_depth_.assign(static_cast<std::size_t>(visibility().gridWidth()) * visibility().gridHeight(),
                      std::numeric_limits<float>::infinity());
-  // The cell of each column once, not two integer divisions per pixel (0.1-0.2 ms a frame).
-  column_cells_.resize(cloud.width);
-  for (int u = 0; u < cloud.width; ++u) column_cells_[u] = visibility().cellOfPixel(u, 0);
   for (int v = 0; v < cloud.height; ++v) {
     const int row_cell = visibility().cellOfPixel(0, v);
     for (int u = 0; u < cloud.width; ++u) {

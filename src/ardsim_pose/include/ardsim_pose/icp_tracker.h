@@ -214,7 +214,7 @@ class IcpTracker : public PoseMethod {
   int nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, float* distance_sq);
   std::vector<int> valid_;
   std::vector<int> valid_cells_;               // their visibility cells
-  std::vector<int> column_cells_;              // scratch: the cell column of each pixel column
+  std::vector<int> column_cells_;              // the cell column of each pixel column
   std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
   std::vector<std::uint8_t> silhouette_;       // see markSilhouette
