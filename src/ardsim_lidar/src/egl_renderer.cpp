@@ -95,12 +95,16 @@ GLuint compileShader(GLenum type, const char* source) {
   return shader;
 }
 
+// A triangle whose plane passes within this of the sensor is drawn and left to the rasteriser to cull.
+constexpr double kEdgeOnToleranceM = 1e-3;
+
 struct Chunk {
   std::size_t first_triangle = 0;
   std::size_t triangle_count = 0;
-  Eigen::Vector3d centre_target = Eigen::Vector3d::Zero();
-  double radius_m = 0.0;
+  Eigen::Vector4f sphere_target = Eigen::Vector4f::Zero();  // bounding sphere: centre (xyz), radius (w)
 };
+
+enum class SphereView { kOutside, kCrossing, kInside };  // a bounding sphere against the view frustum
 
 // Recursive median split on triangle centroids along the longest axis of their bounding box, so each chunk is
 // spatially compact and can be culled as a whole.
@@ -162,7 +166,10 @@ struct EglRenderer::Impl {
   // and the material index.
   std::vector<Eigen::Vector4f> triangle_planes;
   std::vector<float> triangle_materials;
-  TriangleIdFrame read_back;  // render()'s
+  std::vector<GLuint> triangle_indices;           // 3 per triangle in drawing order, as in the index buffer
+  std::vector<Eigen::Vector4f> triangle_spheres;  // bounding sphere per triangle: centre (xyz), radius (w)
+  std::vector<GLuint> draw_indices;               // this frame's selection (draw)
+  TriangleIdFrame read_back;                      // render()'s
   std::size_t triangles_drawn = 0;
   SequenceTiming sequence_timing;
   std::array<float, 16> projection{};  // column-major
@@ -338,7 +345,11 @@ struct EglRenderer::Impl {
   std::size_t pixelCount() const { return static_cast<std::size_t>(sensor.width) * sensor.height; }
   std::size_t frameBytes() const { return pixelCount() * sizeof(std::uint32_t); }
 
-  // Clears the framebuffer and draws the chunks in the view (context current).
+  // Clears the framebuffer and draws the triangles that can be seen (context current). llvmpipe shades,
+  // clips and bins every triangle it is given on the calling thread alone before its rasteriser threads
+  // start, so the triangles facing away from the sensor (half of a closed surface) and those outside the
+  // frustum are left out here, on the CPU, into a per-frame index list: drawing only those the rasteriser
+  // would keep (ISS: 1742-2305 of 5772 triangles at 3-100 m) cut the draw from 0.37-0.50 to 0.34-0.44 ms.
   void draw(const Eigen::Isometry3d& T_lidar_target) {
     // Double precision up to here; the float matrix only carries target-frame vertices of a few tens of
     // metres.
@@ -350,29 +361,58 @@ struct EglRenderer::Impl {
     glClear(GL_DEPTH_BUFFER_BIT);
     triangles_drawn = 0;
     if (chunks.empty()) return;
+    selectTriangles(T_lidar_target);
+    if (draw_indices.empty()) return;
     glUseProgram(program);
     glUniformMatrix4fv(uniform_T_lidar_target, 1, GL_FALSE, T.data());
     glUniformMatrix4fv(uniform_projection, 1, GL_FALSE, projection.data());
     glBindVertexArray(vertex_array);
-    // Visible chunks are merged into contiguous runs, one draw call per run.
-    std::size_t run_first = 0;
-    std::size_t run_count = 0;
-    auto flush = [&]() {
-      if (run_count == 0) return;
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * run_count), GL_UNSIGNED_INT,
-                     reinterpret_cast<const void*>(3 * run_first * sizeof(GLuint)));
-      triangles_drawn += run_count;
-      run_count = 0;
+    // A new store each frame: a frame still queued on a GPU keeps its own (renderSequence).
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(draw_indices.size() * sizeof(GLuint)),
+                 draw_indices.data(), GL_STREAM_DRAW);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(draw_indices.size()), GL_UNSIGNED_INT, nullptr);
+    triangles_drawn = draw_indices.size() / 3;
+  }
+
+  // draw_indices = the front-facing triangles of the chunks in the frustum; in a chunk that crosses the
+  // frustum's border, only the triangles whose bounding sphere reaches inside.
+  void selectTriangles(const Eigen::Isometry3d& T_lidar_target) {
+    draw_indices.clear();
+    // The frustum's planes in target coordinates (inward unit normal in xyz, offset in w: a point p is
+    // inside where n . p + w >= 0), and the sensor there: a triangle faces the sensor where the sensor lies
+    // on the outer side of the triangle's plane. Float: target coordinates span tens of metres.
+    const Eigen::Matrix3d R_target_lidar = T_lidar_target.linear().transpose();
+    const Eigen::Vector3d t = T_lidar_target.translation();
+    std::array<Eigen::Vector4f, 6> planes;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d& normal = side_plane_normals[k];
+      planes[k] << (R_target_lidar * normal).cast<float>(), static_cast<float>(normal.dot(t));
+    }
+    const Eigen::Vector3d boresight_target = R_target_lidar.col(2);
+    planes[4] << boresight_target.cast<float>(), static_cast<float>(t.z() - sensor.near_plane_m);
+    planes[5] << -boresight_target.cast<float>(), static_cast<float>(far_plane_m - t.z());
+    const Eigen::Vector3d eye_target = -(R_target_lidar * t);
+    auto view = [&planes](const Eigen::Vector4f& sphere) {
+      bool inside = true;
+      for (const Eigen::Vector4f& plane : planes) {
+        const float distance = plane.head<3>().dot(sphere.head<3>()) + plane.w();
+        if (distance < -sphere.w()) return SphereView::kOutside;
+        inside = inside && distance >= sphere.w();
+      }
+      return inside ? SphereView::kInside : SphereView::kCrossing;
     };
     for (const Chunk& chunk : chunks) {
-      if (!chunkVisible(chunk, T_lidar_target)) {
-        flush();
-        continue;
+      const SphereView chunk_view = view(chunk.sphere_target);
+      if (chunk_view == SphereView::kOutside) continue;
+      for (std::size_t k = chunk.first_triangle; k < chunk.first_triangle + chunk.triangle_count; ++k) {
+        const Eigen::Vector4f& plane = triangle_planes[k];
+        // A tolerance towards drawing: a triangle seen edge-on is left to the rasteriser's own culling.
+        if (plane.head<3>().cast<double>().dot(eye_target) - plane.w() < -kEdgeOnToleranceM) continue;
+        if (chunk_view == SphereView::kCrossing && view(triangle_spheres[k]) == SphereView::kOutside)
+          continue;
+        draw_indices.insert(draw_indices.end(), &triangle_indices[3 * k], &triangle_indices[3 * k] + 3);
       }
-      if (run_count == 0) run_first = chunk.first_triangle;
-      run_count += chunk.triangle_count;
     }
-    flush();
   }
 
   void checkErrors(const char* what) const {
@@ -402,15 +442,6 @@ struct EglRenderer::Impl {
     side_plane_normals = {
         Eigen::Vector3d(1.0, 0.0, tan_x).normalized(), Eigen::Vector3d(-1.0, 0.0, tan_x).normalized(),
         Eigen::Vector3d(0.0, 1.0, tan_y).normalized(), Eigen::Vector3d(0.0, -1.0, tan_y).normalized()};
-  }
-
-  bool chunkVisible(const Chunk& chunk, const Eigen::Isometry3d& T_lidar_target) const {
-    const Eigen::Vector3d centre = T_lidar_target * chunk.centre_target;
-    if (centre.z() + chunk.radius_m < sensor.near_plane_m || centre.z() - chunk.radius_m > far_plane_m)
-      return false;
-    for (const Eigen::Vector3d& normal : side_plane_normals)
-      if (normal.dot(centre) < -chunk.radius_m) return false;
-    return true;
   }
 };
 
@@ -492,7 +523,11 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
     for (std::size_t i = first; i < first + count; ++i)
       for (int corner = 0; corner < 3; ++corner)
         box.extend(mesh.vertices[indices[3 * i + corner]].cast<double>());
-    chunks.push_back({first, count, box.center(), 0.5 * box.diagonal().norm()});
+    const Eigen::Vector3d centre = box.center();
+    chunks.push_back(
+        {first, count,
+         Eigen::Vector4f(static_cast<float>(centre.x()), static_cast<float>(centre.y()),
+                         static_cast<float>(centre.z()), static_cast<float>(0.5 * box.diagonal().norm()))});
   }
 
   Impl::Current current(*impl_);
@@ -532,10 +567,21 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   glEnableVertexAttribArray(1);
   glVertexAttribIPointer(1, 1, GL_UNSIGNED_INT, sizeof(Vertex),
                          reinterpret_cast<const void*>(3 * sizeof(float)));
+  // Filled per frame with the triangles in view (draw).
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->index_buffer);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)),
-               indices.data(), GL_STATIC_DRAW);
+  std::vector<Eigen::Vector4f> spheres;
+  spheres.reserve(triangle_count);
+  for (std::size_t t = 0; t < triangle_count; ++t) {
+    const Eigen::Vector3f a = mesh.vertices[mesh.triangles[order[t]][0]];
+    const Eigen::Vector3f b = mesh.vertices[mesh.triangles[order[t]][1]];
+    const Eigen::Vector3f c = mesh.vertices[mesh.triangles[order[t]][2]];
+    const Eigen::Vector3f centre = (a + b + c) / 3.0f;
+    const float radius = std::max({(a - centre).norm(), (b - centre).norm(), (c - centre).norm()});
+    spheres.emplace_back(centre.x(), centre.y(), centre.z(), radius);
+  }
   impl_->chunks = std::move(chunks);
+  impl_->triangle_indices = std::move(indices);
+  impl_->triangle_spheres = std::move(spheres);
   impl_->triangle_planes = std::move(planes);
   impl_->triangle_materials = std::move(materials);
   impl_->checkErrors("uploading the mesh");

@@ -48,7 +48,8 @@ struct TriangleIdFrame {
 struct RendererOptions {
   EglPlatform platform = EglPlatform::kAuto;
   // Triangles are grouped into spatially compact chunks; chunks whose bounding sphere lies outside the view
-  // frustum are not drawn (llvmpipe's cost grows with the triangles it is given).
+  // frustum are skipped whole, the triangles of the others tested one by one (llvmpipe's cost grows with the
+  // triangles it is given).
   int triangles_per_chunk = 1024;
 };
 
@@ -96,7 +97,7 @@ class EglRenderer {
   const SequenceTiming& lastSequenceTiming() const;
   const std::string& glRenderer() const;        // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   const std::string& eglPlatform() const;       // "device" or "surfaceless"
-  std::size_t trianglesDrawnLastFrame() const;  // after chunk culling, before back-face culling
+  std::size_t trianglesDrawnLastFrame() const;  // front-facing and in the frustum (draw's selection)
 
  private:
   struct Impl;
