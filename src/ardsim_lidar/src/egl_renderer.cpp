@@ -168,6 +168,9 @@ struct EglRenderer::Impl {
   std::vector<float> triangle_materials;
   std::vector<GLuint> triangle_indices;           // 3 per triangle in drawing order, as in the index buffer
   std::vector<Eigen::Vector4f> triangle_spheres;  // bounding sphere per triangle: centre (xyz), radius (w)
+  std::vector<std::uint32_t> all_triangles;       // 0 .. n - 1 (resolve)
+  std::vector<std::uint32_t> draw_triangles;      // this frame's selection (draw), drawing order
+  std::vector<Eigen::Vector4f> planes_lidar;      // render()'s, of the selected triangles
   std::vector<GLuint> draw_indices;               // this frame's selection (draw)
   TriangleIdFrame read_back;                      // render()'s
   std::size_t triangles_drawn = 0;
@@ -359,9 +362,8 @@ struct EglRenderer::Impl {
     const GLuint no_surface[] = {0, 0, 0, 0};
     glClearBufferuiv(GL_COLOR, 0, no_surface);
     glClear(GL_DEPTH_BUFFER_BIT);
-    triangles_drawn = 0;
-    if (chunks.empty()) return;
     selectTriangles(T_lidar_target);
+    triangles_drawn = draw_triangles.size();
     if (draw_indices.empty()) return;
     glUseProgram(program);
     glUniformMatrix4fv(uniform_T_lidar_target, 1, GL_FALSE, T.data());
@@ -371,13 +373,13 @@ struct EglRenderer::Impl {
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(draw_indices.size() * sizeof(GLuint)),
                  draw_indices.data(), GL_STREAM_DRAW);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(draw_indices.size()), GL_UNSIGNED_INT, nullptr);
-    triangles_drawn = draw_indices.size() / 3;
   }
 
   // draw_indices = the front-facing triangles of the chunks in the frustum; in a chunk that crosses the
   // frustum's border, only the triangles whose bounding sphere reaches inside.
   void selectTriangles(const Eigen::Isometry3d& T_lidar_target) {
     draw_indices.clear();
+    draw_triangles.clear();
     // The frustum's planes in target coordinates (inward unit normal in xyz, offset in w: a point p is
     // inside where n . p + w >= 0), and the sensor there: a triangle faces the sensor where the sensor lies
     // on the outer side of the triangle's plane. Float: target coordinates span tens of metres.
@@ -411,6 +413,7 @@ struct EglRenderer::Impl {
         if (chunk_view == SphereView::kCrossing && view(triangle_spheres[k]) == SphereView::kOutside)
           continue;
         draw_indices.insert(draw_indices.end(), &triangle_indices[3 * k], &triangle_indices[3 * k] + 3);
+        draw_triangles.push_back(static_cast<std::uint32_t>(k));
       }
     }
   }
@@ -442,6 +445,52 @@ struct EglRenderer::Impl {
     side_plane_normals = {
         Eigen::Vector3d(1.0, 0.0, tan_x).normalized(), Eigen::Vector3d(-1.0, 0.0, tan_x).normalized(),
         Eigen::Vector3d(0.0, 1.0, tan_y).normalized(), Eigen::Vector3d(0.0, -1.0, tan_y).normalized()};
+  }
+
+  // The planes of the given triangles in the lidar frame (n . x = d there too), so that each pixel needs only
+  // its dot product with the ray: (n, d) -> (R n, d + (R n) . t) as one 4 x 4 product.
+  void planesInLidar(const Eigen::Isometry3d& T_lidar_target, const std::vector<std::uint32_t>& triangles,
+                     std::vector<Eigen::Vector4f>* planes_lidar) const {
+    Eigen::Matrix4d plane_map = Eigen::Matrix4d::Zero();
+    plane_map.topLeftCorner<3, 3>() = T_lidar_target.linear();
+    plane_map.bottomLeftCorner<1, 3>() = T_lidar_target.translation().transpose() * T_lidar_target.linear();
+    plane_map(3, 3) = 1.0;
+    const Eigen::Matrix4f plane_map_f = plane_map.cast<float>();
+    for (const std::uint32_t k : triangles) (*planes_lidar)[k] = plane_map_f * triangle_planes[k];
+  }
+
+  // The surface at each pixel from its triangle id and the triangles' planes in the lidar frame.
+  void resolvePixels(const TriangleIdFrame& ids, const std::vector<Eigen::Vector4f>& planes_lidar,
+                     RenderedFrame* frame) const {
+    frame->width = ids.width;
+    frame->height = ids.height;
+    frame->pixels.resize(pixelCount());
+    const std::size_t triangle_count = planes_lidar.size();
+    const float near_m = static_cast<float>(sensor.near_plane_m);
+    const float far_m = static_cast<float>(far_plane_m);
+    const int width = ids.width;
+    tbb::parallel_for(tbb::blocked_range<int>(0, ids.height, 16), [&](const tbb::blocked_range<int>& rows) {
+      for (int i = rows.begin() * width; i < rows.end() * width; ++i) {
+        SurfaceSample& sample = frame->pixels[i];
+        const std::uint32_t id = ids.triangle_id[i];
+        if (id == 0 || id > triangle_count) {
+          sample = SurfaceSample{};
+          continue;
+        }
+        const Eigen::Vector4f& plane = planes_lidar[id - 1];
+        const Eigen::Vector3f& ray = rays.ray(i);
+        const float along = plane.head<3>().dot(ray);
+        float range = plane.w() / along;
+        // The rasteriser drew only front faces whose plane the pixel's centre ray crosses, between the near
+        // and the far plane; this only guards the rounding of a plane seen nearly edge-on.
+        const float z = range * ray.z();
+        if (!(z >= near_m)) range = near_m / ray.z();
+        if (!(z <= far_m)) range = far_m / ray.z();
+        sample.range_m = range;
+        sample.cos_incidence = std::abs(along);
+        sample.material = triangle_materials[id - 1];
+      }
+    });
   }
 };
 
@@ -583,6 +632,8 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   impl_->triangle_indices = std::move(indices);
   impl_->triangle_spheres = std::move(spheres);
   impl_->triangle_planes = std::move(planes);
+  impl_->all_triangles.resize(triangle_count);
+  std::iota(impl_->all_triangles.begin(), impl_->all_triangles.end(), 0u);
   impl_->triangle_materials = std::move(materials);
   impl_->checkErrors("uploading the mesh");
 }
@@ -591,6 +642,11 @@ void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame*
   Impl& impl = *impl_;
   Impl::Current current(impl);
   impl.draw(T_lidar_target);
+  // The rasteriser threads start on the flush; the planes of the drawn triangles are moved meanwhile (only
+  // those can be in the frame).
+  glFlush();
+  impl.planes_lidar.resize(impl.triangle_planes.size());
+  impl.planesInLidar(T_lidar_target, impl.draw_triangles, &impl.planes_lidar);
   TriangleIdFrame& ids = impl.read_back;
   ids.width = impl.sensor.width;
   ids.height = impl.sensor.height;
@@ -599,7 +655,7 @@ void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame*
   glReadPixels(0, 0, impl.sensor.width, impl.sensor.height, GL_RED_INTEGER, GL_UNSIGNED_INT,
                ids.triangle_id.data());
   impl.checkErrors("rendering");
-  resolve(ids, T_lidar_target, frame);
+  impl.resolvePixels(ids, impl.planes_lidar, frame);
 }
 
 void EglRenderer::resolve(const TriangleIdFrame& ids, const Eigen::Isometry3d& T_lidar_target,
@@ -609,45 +665,9 @@ void EglRenderer::resolve(const TriangleIdFrame& ids, const Eigen::Isometry3d& T
       ids.triangle_id.size() != impl.pixelCount())
     throw std::invalid_argument("resolve: the id frame is not " + std::to_string(impl.sensor.width) + " x " +
                                 std::to_string(impl.sensor.height));
-  frame->width = ids.width;
-  frame->height = ids.height;
-  frame->pixels.resize(impl.pixelCount());
-  // The planes in the lidar frame (n . x = d there too): a few microseconds, and then each pixel needs only
-  // its dot product with the ray.
-  const std::size_t triangle_count = impl.triangle_planes.size();
-  std::vector<Eigen::Vector4f> planes_lidar(triangle_count);
-  // (n, d) -> (R n, d + (R n) . t) as one 4 x 4 product.
-  Eigen::Matrix4d plane_map = Eigen::Matrix4d::Zero();
-  plane_map.topLeftCorner<3, 3>() = T_lidar_target.linear();
-  plane_map.bottomLeftCorner<1, 3>() = T_lidar_target.translation().transpose() * T_lidar_target.linear();
-  plane_map(3, 3) = 1.0;
-  const Eigen::Matrix4f plane_map_f = plane_map.cast<float>();
-  for (std::size_t k = 0; k < triangle_count; ++k) planes_lidar[k] = plane_map_f * impl.triangle_planes[k];
-  const float near_m = static_cast<float>(impl.sensor.near_plane_m);
-  const float far_m = static_cast<float>(impl.far_plane_m);
-  const int width = ids.width;
-  tbb::parallel_for(tbb::blocked_range<int>(0, ids.height, 16), [&](const tbb::blocked_range<int>& rows) {
-    for (int i = rows.begin() * width; i < rows.end() * width; ++i) {
-      SurfaceSample& sample = frame->pixels[i];
-      const std::uint32_t id = ids.triangle_id[i];
-      if (id == 0 || id > triangle_count) {
-        sample = SurfaceSample{};
-        continue;
-      }
-      const Eigen::Vector4f& plane = planes_lidar[id - 1];
-      const Eigen::Vector3f& ray = impl.rays.ray(i);
-      const float along = plane.head<3>().dot(ray);
-      float range = plane.w() / along;
-      // The rasteriser drew only front faces whose plane the pixel's centre ray crosses, between the near and
-      // the far plane; this only guards the rounding of a plane seen nearly edge-on.
-      const float z = range * ray.z();
-      if (!(z >= near_m)) range = near_m / ray.z();
-      if (!(z <= far_m)) range = far_m / ray.z();
-      sample.range_m = range;
-      sample.cos_incidence = std::abs(along);
-      sample.material = impl.triangle_materials[id - 1];
-    }
-  });
+  std::vector<Eigen::Vector4f> planes_lidar(impl.triangle_planes.size());
+  impl.planesInLidar(T_lidar_target, impl.all_triangles, &planes_lidar);
+  impl.resolvePixels(ids, planes_lidar, frame);
 }
 
 void EglRenderer::renderSequence(const std::vector<Eigen::Isometry3d>& T_lidar_target,
