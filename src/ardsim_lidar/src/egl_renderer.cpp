@@ -145,6 +145,7 @@ struct EglRenderer::Impl {
   EGLContext context = EGL_NO_CONTEXT;
   std::string gl_renderer;
   std::string egl_platform;
+  bool software_rasteriser = false;  // Mesa's llvmpipe or softpipe: draw selects triangles on the CPU
   std::mutex mutex;
 
   GLuint program = 0;
@@ -261,6 +262,8 @@ struct EglRenderer::Impl {
 
   void createPipeline() {
     gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    software_rasteriser = gl_renderer.find("llvmpipe") != std::string::npos ||
+                          gl_renderer.find("softpipe") != std::string::npos;
     GLint major = 0;
     GLint minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
@@ -350,9 +353,11 @@ struct EglRenderer::Impl {
 
   // Clears the framebuffer and draws the triangles that can be seen (context current). llvmpipe shades,
   // clips and bins every triangle it is given on the calling thread alone before its rasteriser threads
-  // start, so the triangles facing away from the sensor (half of a closed surface) and those outside the
-  // frustum are left out here, on the CPU, into a per-frame index list: drawing only those the rasteriser
-  // would keep (ISS: 1742-2305 of 5772 triangles at 3-100 m) cut the draw from 0.37-0.50 to 0.34-0.44 ms.
+  // start, so on a software rasteriser the triangles facing away from the sensor (half of a closed surface)
+  // and those outside the frustum are left out here, on the CPU, into a per-frame index list: drawing only
+  // those (ISS: 1742-2305 of 5772 triangles at 3-100 m) cut the draw from 0.37-0.50 to 0.34-0.44 ms. A GPU
+  // culls them for nothing, and the CPU's selection (~0.05 ms) would bound a pipelined sequence there: it
+  // draws the chunks in the frustum from the mesh's own index buffer.
   void draw(const Eigen::Isometry3d& T_lidar_target) {
     // Double precision up to here; the float matrix only carries target-frame vertices of a few tens of
     // metres.
@@ -362,30 +367,54 @@ struct EglRenderer::Impl {
     const GLuint no_surface[] = {0, 0, 0, 0};
     glClearBufferuiv(GL_COLOR, 0, no_surface);
     glClear(GL_DEPTH_BUFFER_BIT);
-    selectTriangles(T_lidar_target);
-    triangles_drawn = draw_triangles.size();
-    if (draw_indices.empty()) return;
+    triangles_drawn = 0;
+    if (chunks.empty()) return;
     glUseProgram(program);
     glUniformMatrix4fv(uniform_T_lidar_target, 1, GL_FALSE, T.data());
     glUniformMatrix4fv(uniform_projection, 1, GL_FALSE, projection.data());
     glBindVertexArray(vertex_array);
-    // A new store each frame: a frame still queued on a GPU keeps its own (renderSequence).
+    if (!software_rasteriser) {
+      drawChunks(T_lidar_target);
+      return;
+    }
+    selectTriangles(T_lidar_target);
+    triangles_drawn = draw_triangles.size();
+    if (draw_indices.empty()) return;
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(draw_indices.size() * sizeof(GLuint)),
                  draw_indices.data(), GL_STREAM_DRAW);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(draw_indices.size()), GL_UNSIGNED_INT, nullptr);
   }
 
-  // draw_indices = the front-facing triangles of the chunks in the frustum; in a chunk that crosses the
-  // frustum's border, only the triangles whose bounding sphere reaches inside.
-  void selectTriangles(const Eigen::Isometry3d& T_lidar_target) {
-    draw_indices.clear();
-    draw_triangles.clear();
-    // The frustum's planes in target coordinates (inward unit normal in xyz, offset in w: a point p is
-    // inside where n . p + w >= 0), and the sensor there: a triangle faces the sensor where the sensor lies
-    // on the outer side of the triangle's plane. Float: target coordinates span tens of metres.
+  // The chunks in the frustum, merged into contiguous runs, one draw call per run.
+  void drawChunks(const Eigen::Isometry3d& T_lidar_target) {
+    const FrustumPlanes planes = frustumInTarget(T_lidar_target);
+    std::size_t run_first = 0;
+    std::size_t run_count = 0;
+    auto flush = [&]() {
+      if (run_count == 0) return;
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * run_count), GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(3 * run_first * sizeof(GLuint)));
+      triangles_drawn += run_count;
+      run_count = 0;
+    };
+    for (const Chunk& chunk : chunks) {
+      if (sphereView(planes, chunk.sphere_target) == SphereView::kOutside) {
+        flush();
+        continue;
+      }
+      if (run_count == 0) run_first = chunk.first_triangle;
+      run_count += chunk.triangle_count;
+    }
+    flush();
+  }
+
+  // The frustum's planes in target coordinates (inward unit normal in xyz, offset in w: a point p is inside
+  // where n . p + w >= 0). Float: target coordinates span tens of metres.
+  using FrustumPlanes = std::array<Eigen::Vector4f, 6>;
+  FrustumPlanes frustumInTarget(const Eigen::Isometry3d& T_lidar_target) const {
     const Eigen::Matrix3d R_target_lidar = T_lidar_target.linear().transpose();
     const Eigen::Vector3d t = T_lidar_target.translation();
-    std::array<Eigen::Vector4f, 6> planes;
+    FrustumPlanes planes;
     for (std::size_t k = 0; k < 4; ++k) {
       const Eigen::Vector3d& normal = side_plane_normals[k];
       planes[k] << (R_target_lidar * normal).cast<float>(), static_cast<float>(normal.dot(t));
@@ -393,24 +422,37 @@ struct EglRenderer::Impl {
     const Eigen::Vector3d boresight_target = R_target_lidar.col(2);
     planes[4] << boresight_target.cast<float>(), static_cast<float>(t.z() - sensor.near_plane_m);
     planes[5] << -boresight_target.cast<float>(), static_cast<float>(far_plane_m - t.z());
-    const Eigen::Vector3d eye_target = -(R_target_lidar * t);
-    auto view = [&planes](const Eigen::Vector4f& sphere) {
-      bool inside = true;
-      for (const Eigen::Vector4f& plane : planes) {
-        const float distance = plane.head<3>().dot(sphere.head<3>()) + plane.w();
-        if (distance < -sphere.w()) return SphereView::kOutside;
-        inside = inside && distance >= sphere.w();
-      }
-      return inside ? SphereView::kInside : SphereView::kCrossing;
-    };
+    return planes;
+  }
+
+  static SphereView sphereView(const FrustumPlanes& planes, const Eigen::Vector4f& sphere) {
+    bool inside = true;
+    for (const Eigen::Vector4f& plane : planes) {
+      const float distance = plane.head<3>().dot(sphere.head<3>()) + plane.w();
+      if (distance < -sphere.w()) return SphereView::kOutside;
+      inside = inside && distance >= sphere.w();
+    }
+    return inside ? SphereView::kInside : SphereView::kCrossing;
+  }
+
+  // draw_indices = the front-facing triangles of the chunks in the frustum; in a chunk that crosses the
+  // frustum's border, only the triangles whose bounding sphere reaches inside.
+  void selectTriangles(const Eigen::Isometry3d& T_lidar_target) {
+    draw_indices.clear();
+    draw_triangles.clear();
+    const FrustumPlanes planes = frustumInTarget(T_lidar_target);
+    // The sensor in target coordinates: a triangle faces it where it lies on the outer side of the
+    // triangle's plane.
+    const Eigen::Vector3d eye_target = T_lidar_target.inverse().translation();
     for (const Chunk& chunk : chunks) {
-      const SphereView chunk_view = view(chunk.sphere_target);
+      const SphereView chunk_view = sphereView(planes, chunk.sphere_target);
       if (chunk_view == SphereView::kOutside) continue;
       for (std::size_t k = chunk.first_triangle; k < chunk.first_triangle + chunk.triangle_count; ++k) {
         const Eigen::Vector4f& plane = triangle_planes[k];
         // A tolerance towards drawing: a triangle seen edge-on is left to the rasteriser's own culling.
         if (plane.head<3>().cast<double>().dot(eye_target) - plane.w() < -kEdgeOnToleranceM) continue;
-        if (chunk_view == SphereView::kCrossing && view(triangle_spheres[k]) == SphereView::kOutside)
+        if (chunk_view == SphereView::kCrossing &&
+            sphereView(planes, triangle_spheres[k]) == SphereView::kOutside)
           continue;
         draw_indices.insert(draw_indices.end(), &triangle_indices[3 * k], &triangle_indices[3 * k] + 3);
         draw_triangles.push_back(static_cast<std::uint32_t>(k));
@@ -616,8 +658,10 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   glEnableVertexAttribArray(1);
   glVertexAttribIPointer(1, 1, GL_UNSIGNED_INT, sizeof(Vertex),
                          reinterpret_cast<const void*>(3 * sizeof(float)));
-  // Filled per frame with the triangles in view (draw).
+  // A GPU draws from these; a software rasteriser's draw refills the buffer with its selection each frame.
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->index_buffer);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)),
+               indices.data(), GL_STATIC_DRAW);
   std::vector<Eigen::Vector4f> spheres;
   spheres.reserve(triangle_count);
   for (std::size_t t = 0; t < triangle_count; ++t) {
@@ -646,7 +690,8 @@ void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame*
   // those can be in the frame).
   glFlush();
   impl.planes_lidar.resize(impl.triangle_planes.size());
-  impl.planesInLidar(T_lidar_target, impl.draw_triangles, &impl.planes_lidar);
+  impl.planesInLidar(T_lidar_target, impl.software_rasteriser ? impl.draw_triangles : impl.all_triangles,
+                     &impl.planes_lidar);
   TriangleIdFrame& ids = impl.read_back;
   ids.width = impl.sensor.width;
   ids.height = impl.sensor.height;
