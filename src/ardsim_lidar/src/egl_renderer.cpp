@@ -169,7 +169,6 @@ struct EglRenderer::Impl {
   std::vector<float> triangle_materials;
   std::vector<GLuint> triangle_indices;           // 3 per triangle in drawing order, as in the index buffer
   std::vector<Eigen::Vector4f> triangle_spheres;  // bounding sphere per triangle: centre (xyz), radius (w)
-  std::vector<std::uint32_t> all_triangles;       // 0 .. n - 1 (resolve)
   std::vector<std::uint32_t> draw_triangles;      // this frame's selection (draw), drawing order
   std::vector<Eigen::Vector4f> planes_lidar;      // render()'s, of the selected triangles
   std::vector<GLuint> draw_indices;               // this frame's selection (draw)
@@ -489,16 +488,23 @@ struct EglRenderer::Impl {
         Eigen::Vector3d(0.0, 1.0, tan_y).normalized(), Eigen::Vector3d(0.0, -1.0, tan_y).normalized()};
   }
 
-  // The planes of the given triangles in the lidar frame (n . x = d there too), so that each pixel needs only
-  // its dot product with the ray: (n, d) -> (R n, d + (R n) . t) as one 4 x 4 product.
-  void planesInLidar(const Eigen::Isometry3d& T_lidar_target, const std::vector<std::uint32_t>& triangles,
+  // The planes of the given triangles (all where triangles is null) in the lidar frame (n . x = d there too),
+  // so that each pixel needs only its dot product with the ray: (n, d) -> (R n, d + (R n) . t) as one 4 x 4
+  // product.
+  void planesInLidar(const Eigen::Isometry3d& T_lidar_target, const std::vector<std::uint32_t>* triangles,
                      std::vector<Eigen::Vector4f>* planes_lidar) const {
     Eigen::Matrix4d plane_map = Eigen::Matrix4d::Zero();
     plane_map.topLeftCorner<3, 3>() = T_lidar_target.linear();
     plane_map.bottomLeftCorner<1, 3>() = T_lidar_target.translation().transpose() * T_lidar_target.linear();
     plane_map(3, 3) = 1.0;
     const Eigen::Matrix4f plane_map_f = plane_map.cast<float>();
-    for (const std::uint32_t k : triangles) (*planes_lidar)[k] = plane_map_f * triangle_planes[k];
+    planes_lidar->resize(triangle_planes.size());
+    if (triangles == nullptr) {
+      for (std::size_t k = 0; k < triangle_planes.size(); ++k)
+        (*planes_lidar)[k] = plane_map_f * triangle_planes[k];
+      return;
+    }
+    for (const std::uint32_t k : *triangles) (*planes_lidar)[k] = plane_map_f * triangle_planes[k];
   }
 
   // The surface at each pixel from its triangle id and the triangles' planes in the lidar frame.
@@ -676,8 +682,6 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   impl_->triangle_indices = std::move(indices);
   impl_->triangle_spheres = std::move(spheres);
   impl_->triangle_planes = std::move(planes);
-  impl_->all_triangles.resize(triangle_count);
-  std::iota(impl_->all_triangles.begin(), impl_->all_triangles.end(), 0u);
   impl_->triangle_materials = std::move(materials);
   impl_->checkErrors("uploading the mesh");
 }
@@ -689,8 +693,7 @@ void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame*
   // The rasteriser threads start on the flush; the planes of the drawn triangles are moved meanwhile (only
   // those can be in the frame).
   glFlush();
-  impl.planes_lidar.resize(impl.triangle_planes.size());
-  impl.planesInLidar(T_lidar_target, impl.software_rasteriser ? impl.draw_triangles : impl.all_triangles,
+  impl.planesInLidar(T_lidar_target, impl.software_rasteriser ? &impl.draw_triangles : nullptr,
                      &impl.planes_lidar);
   TriangleIdFrame& ids = impl.read_back;
   ids.width = impl.sensor.width;
@@ -710,8 +713,8 @@ void EglRenderer::resolve(const TriangleIdFrame& ids, const Eigen::Isometry3d& T
       ids.triangle_id.size() != impl.pixelCount())
     throw std::invalid_argument("resolve: the id frame is not " + std::to_string(impl.sensor.width) + " x " +
                                 std::to_string(impl.sensor.height));
-  std::vector<Eigen::Vector4f> planes_lidar(impl.triangle_planes.size());
-  impl.planesInLidar(T_lidar_target, impl.all_triangles, &planes_lidar);
+  std::vector<Eigen::Vector4f> planes_lidar;
+  impl.planesInLidar(T_lidar_target, nullptr, &planes_lidar);
   impl.resolvePixels(ids, planes_lidar, frame);
 }
 
