@@ -145,7 +145,7 @@ struct EglRenderer::Impl {
   EGLContext context = EGL_NO_CONTEXT;
   std::string gl_renderer;
   std::string egl_platform;
-  bool software_rasteriser = false;  // Mesa's llvmpipe or softpipe: draw selects triangles on the CPU
+  bool cpu_culling = false;  // RendererOptions::cpu_culling resolved for this GL_RENDERER
   std::mutex mutex;
 
   GLuint program = 0;
@@ -261,8 +261,10 @@ struct EglRenderer::Impl {
 
   void createPipeline() {
     gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    software_rasteriser = gl_renderer.find("llvmpipe") != std::string::npos ||
-                          gl_renderer.find("softpipe") != std::string::npos;
+    const bool software_rasteriser = gl_renderer.find("llvmpipe") != std::string::npos ||
+                                     gl_renderer.find("softpipe") != std::string::npos;
+    cpu_culling = options.cpu_culling == CpuCulling::kOn ||
+                  (options.cpu_culling == CpuCulling::kAuto && software_rasteriser);
     GLint major = 0;
     GLint minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
@@ -372,7 +374,7 @@ struct EglRenderer::Impl {
     glUniformMatrix4fv(uniform_T_lidar_target, 1, GL_FALSE, T.data());
     glUniformMatrix4fv(uniform_projection, 1, GL_FALSE, projection.data());
     glBindVertexArray(vertex_array);
-    if (!software_rasteriser) {
+    if (!cpu_culling) {
       drawChunks(T_lidar_target);
       return;
     }
@@ -693,8 +695,7 @@ void EglRenderer::render(const Eigen::Isometry3d& T_lidar_target, RenderedFrame*
   // The rasteriser threads start on the flush; the planes of the drawn triangles are moved meanwhile (only
   // those can be in the frame).
   glFlush();
-  impl.planesInLidar(T_lidar_target, impl.software_rasteriser ? &impl.draw_triangles : nullptr,
-                     &impl.planes_lidar);
+  impl.planesInLidar(T_lidar_target, impl.cpu_culling ? &impl.draw_triangles : nullptr, &impl.planes_lidar);
   TriangleIdFrame& ids = impl.read_back;
   ids.width = impl.sensor.width;
   ids.height = impl.sensor.height;

@@ -45,8 +45,18 @@ struct TriangleIdFrame {
   std::vector<std::uint32_t> triangle_id;  // row-major, row 0 at the top of the image (y down)
 };
 
+// Whether each frame's triangles are selected on the CPU before drawing: only those facing the sensor whose
+// bounding sphere reaches into the frustum go to OpenGL, through a per-frame index buffer. llvmpipe shades,
+// clips and bins every triangle it is given on one thread before rasterising; a GPU culls for nothing.
+enum class CpuCulling {
+  kAuto,  // on a software rasteriser (GL_RENDERER llvmpipe or softpipe), not on a GPU
+  kOn,
+  kOff,  // chunks wholly outside the frustum are still skipped
+};
+
 struct RendererOptions {
   EglPlatform platform = EglPlatform::kAuto;
+  CpuCulling cpu_culling = CpuCulling::kAuto;
   // Triangles are grouped into spatially compact chunks; chunks whose bounding sphere lies outside the view
   // frustum are skipped whole, the triangles of the others tested one by one (llvmpipe's cost grows with the
   // triangles it is given).
@@ -97,7 +107,7 @@ class EglRenderer {
   const SequenceTiming& lastSequenceTiming() const;
   const std::string& glRenderer() const;        // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   const std::string& eglPlatform() const;       // "device" or "surfaceless"
-  std::size_t trianglesDrawnLastFrame() const;  // front-facing and in the frustum (draw's selection)
+  std::size_t trianglesDrawnLastFrame() const;  // given to OpenGL (after the CPU's culling, if any)
 
  private:
   struct Impl;
