@@ -607,6 +607,8 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   planes.reserve(triangle_count);
   std::vector<float> materials;
   materials.reserve(triangle_count);
+  std::vector<Eigen::Vector4f> spheres;  // bounding sphere about the centroid
+  spheres.reserve(triangle_count);
   for (std::size_t t : order) {
     const Eigen::Vector3i& tri = mesh.triangles[t];
     for (int corner = 0; corner < 3; ++corner) indices.push_back(static_cast<GLuint>(tri[corner]));
@@ -615,6 +617,11 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
                                        .normalized();
     planes.emplace_back(normal.x(), normal.y(), normal.z(), normal.dot(mesh.vertices[tri[0]]));
     materials.push_back(static_cast<float>(mesh.triangle_material[t]));
+    const Eigen::Vector3f& centre = centroids[t];
+    float radius = 0.0f;
+    for (int corner = 0; corner < 3; ++corner)
+      radius = std::max(radius, (mesh.vertices[tri[corner]] - centre).norm());
+    spheres.emplace_back(centre.x(), centre.y(), centre.z(), radius);
   }
   std::vector<Chunk> chunks;
   for (const auto& [first, count] : ranges) {
@@ -670,16 +677,6 @@ void EglRenderer::setMesh(const ardsim_description::TriangleMesh& mesh) {
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->index_buffer);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)),
                indices.data(), GL_STATIC_DRAW);
-  std::vector<Eigen::Vector4f> spheres;
-  spheres.reserve(triangle_count);
-  for (std::size_t t = 0; t < triangle_count; ++t) {
-    const Eigen::Vector3f a = mesh.vertices[mesh.triangles[order[t]][0]];
-    const Eigen::Vector3f b = mesh.vertices[mesh.triangles[order[t]][1]];
-    const Eigen::Vector3f c = mesh.vertices[mesh.triangles[order[t]][2]];
-    const Eigen::Vector3f centre = (a + b + c) / 3.0f;
-    const float radius = std::max({(a - centre).norm(), (b - centre).norm(), (c - centre).norm()});
-    spheres.emplace_back(centre.x(), centre.y(), centre.z(), radius);
-  }
   impl_->chunks = std::move(chunks);
   impl_->triangle_indices = std::move(indices);
   impl_->triangle_spheres = std::move(spheres);

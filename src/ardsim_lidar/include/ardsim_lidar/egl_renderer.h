@@ -58,8 +58,8 @@ struct RendererOptions {
   EglPlatform platform = EglPlatform::kAuto;
   CpuCulling cpu_culling = CpuCulling::kAuto;
   // Triangles are grouped into spatially compact chunks; chunks whose bounding sphere lies outside the view
-  // frustum are skipped whole, the triangles of the others tested one by one (llvmpipe's cost grows with the
-  // triangles it is given).
+  // frustum are skipped whole; with CPU culling the triangles of the others are tested one by one (llvmpipe's
+  // cost grows with the triangles it is given).
   int triangles_per_chunk = 1024;
 };
 
