@@ -35,9 +35,10 @@ VehicleModel buildHubbleModel(const HubbleOptions& options) {
   }
   // High-gain antennas on booms at the +-z sides [estimate: 1.3 m dishes on 2 m booms].
   for (double side : {-1.0, 1.0}) {
-    const Surface antenna{skin, b.part("high_gain_antennas", true)};
-    b.box(at(0.0, 0, side * 3.1), Eigen::Vector3d(0.1, 0.1, 2.0), antenna, Collide::kYes);
-    b.frustum(at(0.0, 0, side * 4.1) * alongZ(), 0.65, 0.2, -0.15, 0.15, 24, antenna, Collide::kYes);
+    b.box(at(0.0, 0, side * 3.1), Eigen::Vector3d(0.1, 0.1, 2.0),
+          {skin, b.part("high_gain_antenna_booms", false)}, Collide::kYes);
+    b.frustum(at(0.0, 0, side * 4.1) * alongZ(), 0.65, 0.2, -0.15, 0.15, 24,
+              {skin, b.part("high_gain_antennas", true)}, Collide::kYes);
   }
 
   // Soft Capture Mechanism (SM4, 2009) on the aft bulkhead: an IDSS-compatible ring with reflector targets
