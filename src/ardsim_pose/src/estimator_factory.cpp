@@ -10,10 +10,6 @@ namespace ardsim_pose {
 void validate(const PoseConfig& c) {
   if (c.method != "icp" && c.method != "auto" && c.method != "ring" && c.method != "pyramid")
     throw std::invalid_argument("method = '" + c.method + "' is not allowed: icp, auto, ring or pyramid");
-  if ((c.method == "ring" || c.method == "pyramid") && c.target != ardsim_description::TargetKind::kIss)
-    throw std::invalid_argument("method = '" + c.method +
-                                "' needs target iss (the close-range methods model " +
-                                "the ISS docking adapter)");
   close_range::validate(c.mode);
   ardsim_lidar::validate(c.sensor);
   validate(c.model);
@@ -48,8 +44,8 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
   methods[EstimateMethod::kIcp] = std::make_unique<IcpTracker>(
       std::move(model), ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
   std::unique_ptr<MethodSelector> selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp);
-  if (config.target == ardsim_description::TargetKind::kIss) {
-    const close_range::AdapterGeometry geometry = close_range::issAdapterGeometry();
+  {
+    const close_range::AdapterGeometry geometry = close_range::adapterGeometry(config.target);
     methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, config.ring);
     methods[EstimateMethod::kPyramid] =
         std::make_unique<close_range::PyramidMethod>(geometry, config.pyramid);

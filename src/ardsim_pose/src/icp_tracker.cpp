@@ -700,6 +700,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   coverage_ = 0.0;
   scan_.clear();
   const bool acquiring = acquiring_;
+  result.acquiring = acquiring;
   auto lost = [&](const std::string& reason) {
     result.status = EstimateStatus::kLost;
     result.reason = reason;

@@ -1,4 +1,5 @@
-// The estimator facade (PoseEstimator) with a scripted method: the median filter on a steady approach.
+// The estimator facade (PoseEstimator) with scripted methods: the median filter on a steady approach, and
+// what the motion prediction learns from TRACKING, DEGRADED and acquisition estimates.
 #include <cmath>
 #include <map>
 #include <memory>
@@ -52,6 +53,105 @@ TEST(PoseEstimatorMedianFilter, NeitherLagsASteadyApproachNorPassesAnOutlier) {
     // Across: within the scripted noise, the outlier rejected once the window holds three estimates.
     EXPECT_LT(std::abs(error.x()), frame == 12 ? 0.05 : 0.021);
   }
+}
+
+// The truth of a target closing at 5 m/s and turning at a constant rate, 1 deg a frame about the boresight
+// and 0.5 deg about lidar x; per frame a scripted status. Records the prediction each frame was given.
+class MotionScript : public PoseMethod {
+ public:
+  struct Step {
+    EstimateStatus status = EstimateStatus::kTracking;
+    bool acquiring = false;
+    bool boresight_observed = true;
+  };
+  explicit MotionScript(std::map<int, Step> steps) : steps_(std::move(steps)) {}
+  static Eigen::Isometry3d truth(int frame) {
+    Eigen::Isometry3d T = truthAt(0.1 * frame);
+    const Eigen::Vector3d turn_per_frame_rad = Eigen::Vector3d(0.5, 0.0, 1.0) * M_PI / 180.0;
+    T.linear() = Eigen::AngleAxisd(frame * turn_per_frame_rad.norm(), turn_per_frame_rad.normalized())
+                     .toRotationMatrix();
+    return T;
+  }
+  PoseResult estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& predicted) override {
+    const int frame = static_cast<int>(std::lround(cloud.stamp_s * 10.0));
+    predictions[frame] = predicted;
+    const Step step = steps_.count(frame) ? steps_.at(frame) : Step{};
+    PoseResult result;
+    result.status = step.status;
+    result.acquiring = step.acquiring;
+    result.boresight_rotation_observed = step.boresight_observed;
+    result.T_lidar_target = truth(frame);
+    return result;
+  }
+  void reset() override {}
+  std::map<int, Eigen::Isometry3d> predictions;
+
+ private:
+  std::map<int, Step> steps_;
+};
+
+double angleDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
+}
+
+TEST(PoseEstimatorPrediction, DegradedKeepsTheLinearVelocityAcquisitionResetsIt) {
+  using Step = MotionScript::Step;
+  std::map<int, Step> steps;
+  steps[5] = Step{EstimateStatus::kDegraded, false, true};  // tracking, but degraded
+  steps[9] = Step{EstimateStatus::kDegraded, true, true};   // an acquisition estimate
+  auto script = std::make_unique<MotionScript>(steps);
+  MotionScript* probe = script.get();
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::move(script);
+  PoseEstimator estimator(EstimatorOptions{}, std::move(methods),
+                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
+  estimator.setPrior(MotionScript::truth(0));
+  OrganizedCloud cloud;
+  for (int frame = 0; frame < 13; ++frame) {
+    cloud.stamp_s = 0.1 * frame;
+    estimator.process(cloud);
+  }
+  auto position_error = [&](int frame) {
+    return (probe->predictions.at(frame).translation() - MotionScript::truth(frame).translation()).norm();
+  };
+  // Learnt from TRACKING pairs: the next frame predicted exactly.
+  EXPECT_LT(position_error(5), 1e-9);
+  EXPECT_LT(angleDeg(probe->predictions.at(5), MotionScript::truth(5)), 1e-6);
+  // After the DEGRADED frame: the linear velocity kept (it was reset before: 0.5 m off), the angular one
+  // dropped (the prediction keeps frame 5's attitude).
+  EXPECT_LT(position_error(6), 1e-9);
+  EXPECT_NEAR(angleDeg(probe->predictions.at(6), MotionScript::truth(5)), 0.0, 1e-6);
+  // After the acquisition estimate: no velocity at all, the prediction is that estimate; so after the next
+  // (TRACKING, but paired with the acquisition's).
+  EXPECT_NEAR(position_error(10), 0.5, 1e-9);
+  EXPECT_NEAR(position_error(11), 0.5, 1e-9);
+  // After a TRACKING pair it is learnt again.
+  EXPECT_LT(position_error(12), 1e-9);
+}
+
+TEST(PoseEstimatorPrediction, AnUnobservedBoresightRotationIsNoMotion) {
+  using Step = MotionScript::Step;
+  std::map<int, Step> steps;
+  for (int frame = 0; frame < 6; ++frame) steps[frame] = Step{EstimateStatus::kTracking, false, false};
+  auto script = std::make_unique<MotionScript>(steps);
+  MotionScript* probe = script.get();
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::move(script);
+  PoseEstimator estimator(EstimatorOptions{}, std::move(methods),
+                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
+  estimator.setPrior(MotionScript::truth(0));
+  OrganizedCloud cloud;
+  for (int frame = 0; frame < 6; ++frame) {
+    cloud.stamp_s = 0.1 * frame;
+    estimator.process(cloud);
+  }
+  // The turn about lidar x is extrapolated, the one about the boresight (held by the method) is not. (The
+  // prediction's turn from frame 4 is the rotation vector's x part of one frame's turn.)
+  const Eigen::Matrix3d R = probe->predictions.at(5).linear() * MotionScript::truth(4).linear().transpose();
+  const Eigen::AngleAxisd turn(R);
+  const Eigen::Vector3d turn_deg = turn.angle() * turn.axis() * 180.0 / M_PI;
+  EXPECT_NEAR(turn_deg.z(), 0.0, 1e-3);
+  EXPECT_NEAR(std::abs(turn_deg.x()), 0.5, 0.02);
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ struct Case {
 // slightly different pose as in tracking.
 const Case& frameAt(int range_cm) {
   static std::map<int, Case> cases;
-  static testing::IssRenderer renderer(true);
+  static testing::TargetRenderer renderer(true);
   auto it = cases.find(range_cm);
   if (it != cases.end()) return it->second;
   testing::ApproachState s;

@@ -21,7 +21,8 @@ struct PoseConfig {
   ardsim_description::TargetKind target = ardsim_description::TargetKind::kIss;
   ardsim_lidar::SensorOptions sensor;  // width, height and fov_deg must match the lidar's
   // "icp", "ring", "pyramid": that method every frame. "auto": the close-range mode manager (ICP far out, the
-  // close-range method near; ICP only for targets without the docking adapter's close-range model, Hubble).
+  // close-range method near: the ISS's docking adapter and Hubble's soft-capture mechanism, the same IDSS
+  // ring).
   std::string method = "icp";
   ReferenceModelOptions model;
   VisibilityOptions visibility;

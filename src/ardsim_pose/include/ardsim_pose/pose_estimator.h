@@ -74,7 +74,7 @@ class PoseEstimator {
   Eigen::Isometry3d predict(double stamp_s) const;
 
  private:
-  void updateVelocity(const Eigen::Isometry3d& T, EstimateStatus status, double stamp_s);
+  void updateVelocity(const PoseResult& result, double stamp_s);
   // The filtered pose at stamp_s from (stamp, raw estimate) pairs.
   Eigen::Isometry3d medianOf(const std::deque<std::pair<double, Eigen::Isometry3d>>& recent,
                              double stamp_s) const;

@@ -29,6 +29,10 @@ struct PoseResult {
   Eigen::Matrix<double, 6, 6> covariance =
       Eigen::Matrix<double, 6, 6>::Zero();  // (x y z, rot x y z) m^2, rad^2
   bool boresight_rotation_observed = true;
+  // From a method still acquiring (ICP's search from a prior, after LOST): the estimate may jump from the
+  // last one, so it says nothing about the motion. A DEGRADED estimate that is not acquiring still moves with
+  // the target.
+  bool acquiring = false;
   double fit_rms_m = 0.0;
   double inlier_fraction = 0.0;
   int points_used = 0;

@@ -73,6 +73,21 @@ AdapterGeometry issAdapterGeometry() {
   return g;
 }
 
+AdapterGeometry hubbleAdapterGeometry() {
+  AdapterGeometry g;
+  // No hatch: the aft bulkhead closes the passage 0.30 m behind the docking plane (ardsim_description
+  // hubble.cpp, the tunnel's depth with hatch_depth_m = 0); no centreline target (its plate and cross lie
+  // where the bulkhead hides them: no points there).
+  g.hatch_face_x_m = -0.30;
+  g.plate_radius_m = 0.0;
+  g.T_target_port = ardsim_description::T_target_port(ardsim_description::TargetKind::kHubble);
+  return g;
+}
+
+AdapterGeometry adapterGeometry(ardsim_description::TargetKind kind) {
+  return kind == ardsim_description::TargetKind::kIss ? issAdapterGeometry() : hubbleAdapterGeometry();
+}
+
 void prepareFrame(const OrganizedCloud& cloud, const AdapterFitOptions& options, PreparedFrame* frame) {
   const int n = cloud.width * cloud.height;
   frame->width = cloud.width;

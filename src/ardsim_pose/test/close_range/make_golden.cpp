@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string dir = argv[1];
-  testing::IssRenderer renderer(true, 7);
+  testing::TargetRenderer renderer(true, 7);
   std::vector<ardsim_pose::OrganizedCloud> frames;
   std::ofstream truth(dir + "/truth.csv");
   truth.precision(12);

@@ -1,5 +1,5 @@
-// Close-range frames rendered in-process with ardsim_lidar's LidarSimulator, and the error measures of the
-// close-range goals. Shared by the tests and the benchmark.
+// Close-range frames of the ISS or Hubble rendered in-process with ardsim_lidar's LidarSimulator, and the
+// error measures of the close-range goals. Shared by the tests and the benchmark.
 #pragma once
 
 #include <cmath>
@@ -30,7 +30,8 @@ struct ApproachState {
   double roll_deg = 0.0;
 };
 
-inline Eigen::Isometry3d T_lidar_target(const ApproachState& s) {
+inline Eigen::Isometry3d T_lidar_target(
+    const ApproachState& s, ardsim_description::TargetKind kind = ardsim_description::TargetKind::kIss) {
   using namespace ardsim_description;
   const Eigen::Isometry3d T_port_chaser_port =
       Eigen::Translation3d(s.port_range_m, s.lateral_y_m, s.lateral_z_m) *
@@ -38,17 +39,18 @@ inline Eigen::Isometry3d T_lidar_target(const ApproachState& s) {
       Eigen::AngleAxisd(s.tilt_z_deg * kDegToRad, Eigen::Vector3d::UnitZ()) *
       Eigen::AngleAxisd(s.roll_deg * kDegToRad, Eigen::Vector3d::UnitX()) * T_port_port_docked();
   const Eigen::Isometry3d T_port_lidar = T_port_chaser_port * T_chaser_port().inverse() * T_chaser_lidar();
-  return (T_target_port(TargetKind::kIss) * T_port_lidar).inverse();
+  return (T_target_port(kind) * T_port_lidar).inverse();
 }
 
-class IssRenderer {
+class TargetRenderer {
  public:
-  explicit IssRenderer(bool noise, std::uint64_t seed = 7) {
+  explicit TargetRenderer(bool noise, std::uint64_t seed = 7,
+                          ardsim_description::TargetKind kind = ardsim_description::TargetKind::kIss) {
     ardsim_lidar::NoiseOptions noise_options;
     noise_options.enabled = noise;
     simulator_ =
         std::make_unique<ardsim_lidar::LidarSimulator>(ardsim_lidar::SensorOptions{}, noise_options, seed);
-    simulator_->setTarget(ardsim_description::buildTarget(ardsim_description::TargetKind::kIss));
+    simulator_->setTarget(ardsim_description::buildTarget(kind));
   }
 
   OrganizedCloud render(const Eigen::Isometry3d& T, std::uint64_t frame_index) {
@@ -79,8 +81,9 @@ struct PortError {
   double lateral() const { return std::hypot(lateral_x_m, lateral_y_m); }
 };
 
-inline PortError portError(const Eigen::Isometry3d& T_estimate, const Eigen::Isometry3d& T_truth) {
-  const Eigen::Isometry3d T_port = ardsim_description::T_target_port(ardsim_description::TargetKind::kIss);
+inline PortError portError(const Eigen::Isometry3d& T_estimate, const Eigen::Isometry3d& T_truth,
+                           ardsim_description::TargetKind kind = ardsim_description::TargetKind::kIss) {
+  const Eigen::Isometry3d T_port = ardsim_description::T_target_port(kind);
   const Eigen::Isometry3d estimate = T_estimate * T_port, truth = T_truth * T_port;
   PortError e;
   const Eigen::Vector3d dp = estimate.translation() - truth.translation();

@@ -1,4 +1,5 @@
-// The close-range methods on rendered frames of the ISS docking adapter (issue 5 goals).
+// The close-range methods on rendered frames of the ISS docking adapter (issue 5 goals) and of Hubble's
+// soft-capture mechanism.
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -16,8 +17,8 @@ namespace close_range {
 namespace {
 
 using testing::ApproachState;
-using testing::IssRenderer;
 using testing::PortError;
+using testing::TargetRenderer;
 
 // The prediction handed to a method: the truth disturbed as a previous estimate or ICP's would be.
 Eigen::Isometry3d predictionFrom(ApproachState s) {
@@ -81,7 +82,7 @@ std::vector<ApproachState> closeRangeStates() {
 }
 
 Sweep runSweep(EstimateMethod method, bool noise) {
-  IssRenderer renderer(noise);
+  TargetRenderer renderer(noise);
   std::unique_ptr<PoseMethod> estimator = makeMethod(method, noise);
   Sweep sweep;
   int index = 0;
@@ -141,7 +142,7 @@ TEST_P(CloseRangeGoals, FromSevenMetresToContact) {
 // (0.26-0.40 m). The prediction is 8 deg off in roll, so each frame's measurement is taken as it is (no
 // tracking filter).
 TEST(CloseRangeReflectors, BoresightAngleFromOneFrame) {
-  IssRenderer renderer(true);
+  TargetRenderer renderer(true);
   std::unique_ptr<PoseMethod> estimator = makeMethod(EstimateMethod::kRing, true);
   int index = 0;
   double roll_sq = 0.0, roll_max_deg = 0.0;
@@ -170,6 +171,75 @@ TEST(CloseRangeReflectors, BoresightAngleFromOneFrame) {
   EXPECT_LE(roll_max_deg, 0.15);
 }
 
+// Hubble's soft-capture mechanism: the same IDSS ring, petals and reflectors, the aft bulkhead 0.30 m behind
+// the docking plane instead of a hatch, no centreline target (hubbleAdapterGeometry; the detectors' depth
+// steps, 0.25-0.3 m, are the ISS's). From the 12 m hand-over to the 5 m hold of hubble_hold and on
+// to 1.5 m, with tilts, offsets and rolls as above; the ISS's close-range goals.
+class CloseRangeHubble : public ::testing::TestWithParam<EstimateMethod> {};
+
+TEST_P(CloseRangeHubble, FromTwelveMetresToOneAndAHalf) {
+  using ardsim_description::TargetKind;
+  TargetRenderer renderer(true, 7, TargetKind::kHubble);
+  std::unique_ptr<PoseMethod> method;
+  if (GetParam() == EstimateMethod::kPyramid)
+    method = std::make_unique<PyramidMethod>(hubbleAdapterGeometry());
+  else
+    method = std::make_unique<RingMethod>(hubbleAdapterGeometry());
+  int index = 0, lost = 0, observed = 0;
+  double lateral_max_m = 0.0, range_max_m = 0.0, tilt_sq = 0.0, roll_max_deg = 0.0;
+  for (double range : {11.5, 10.0, 8.5, 7.0, 6.0, 5.0, 4.0, 3.0, 2.0, 1.5}) {
+    for (int variant = 0; variant < 3; ++variant, ++index) {
+      ApproachState s;
+      s.port_range_m = range;
+      s.tilt_y_deg = 3.0 * std::sin(1.3 * index);
+      s.tilt_z_deg = 3.0 * std::cos(1.7 * index);
+      s.lateral_y_m = 0.06 * std::sin(0.9 * index);
+      s.lateral_z_m = 0.06 * std::cos(1.1 * index);
+      s.roll_deg = 25.0 * std::sin(2.1 * index);
+      const Eigen::Isometry3d truth = testing::T_lidar_target(s, TargetKind::kHubble);
+      ApproachState predicted = s;
+      predicted.lateral_y_m += 0.03;
+      predicted.port_range_m += 0.05;
+      predicted.tilt_y_deg += 0.5;
+      // The tracked angle: a jump beyond the 1.5 deg gate would be taken as it is.
+      predicted.roll_deg += 0.5;
+      const PoseResult result = method->estimate(renderer.render(truth, index),
+                                                 testing::T_lidar_target(predicted, TargetKind::kHubble));
+      if (result.status == EstimateStatus::kLost) {
+        ++lost;
+        std::printf("hubble %s range %.1f: LOST %s\n", name(GetParam()), range, result.reason.c_str());
+        continue;
+      }
+      const PortError e = testing::portError(result.T_lidar_target, truth, TargetKind::kHubble);
+      std::printf("hubble %s range %.1f: lateral %+.4f %+.4f range %+.4f tilt %+.3f %+.3f roll %+.2f (%s)\n",
+                  name(GetParam()), range, e.lateral_x_m, e.lateral_y_m, e.range_m, e.rotation_deg.y(),
+                  e.rotation_deg.z(), e.rotation_deg.x(),
+                  result.boresight_rotation_observed ? "observed" : "held");
+      lateral_max_m = std::max(lateral_max_m, e.lateral());
+      range_max_m = std::max(range_max_m, std::abs(e.range_m));
+      tilt_sq += e.rotation_deg.y() * e.rotation_deg.y() + e.rotation_deg.z() * e.rotation_deg.z();
+      if (result.boresight_rotation_observed) {
+        ++observed;
+        roll_max_deg = std::max(roll_max_deg, std::abs(e.rotation_deg.x()));
+      }
+    }
+  }
+  const double tilt_rms_deg = std::sqrt(tilt_sq / std::max(1, 2 * (index - lost)));
+  std::printf(
+      "hubble %s: frames %d lost %d lateral_max %.4f m range_max %.4f m tilt_rms %.4f deg roll_max %.3f "
+      "deg (observed on %d)\n",
+      name(GetParam()), index, lost, lateral_max_m, range_max_m, tilt_rms_deg, roll_max_deg, observed);
+  EXPECT_EQ(lost, 0);
+  EXPECT_LE(lateral_max_m, 0.02);
+  EXPECT_LE(range_max_m, 0.01);
+  EXPECT_LE(tilt_rms_deg, 0.2);
+  EXPECT_LE(roll_max_deg, 1.0);
+  EXPECT_GE(observed, index / 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, CloseRangeHubble,
+                         ::testing::Values(EstimateMethod::kRing, EstimateMethod::kPyramid));
+
 INSTANTIATE_TEST_SUITE_P(Methods, CloseRangeGoals,
                          ::testing::Combine(::testing::Values(EstimateMethod::kRing,
                                                               EstimateMethod::kPyramid),
@@ -197,7 +267,7 @@ void expectLostOrRight(PoseMethod& method, const OrganizedCloud& cloud, const Ei
 }
 
 TEST(CloseRangeLost, RingOutOfViewOccludedOrEmpty) {
-  IssRenderer renderer(true);
+  TargetRenderer renderer(true);
   RingMethod ring;
   PyramidMethod pyramid;
   for (double range : {4.0, 2.0, 0.5}) {

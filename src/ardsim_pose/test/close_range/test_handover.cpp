@@ -22,7 +22,7 @@ double rms(const std::vector<double>& values) {
 }
 
 TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
-  testing::IssRenderer renderer(true, 11);
+  testing::TargetRenderer renderer(true, 11);
   PoseConfig config;
   config.method = "auto";
   std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);

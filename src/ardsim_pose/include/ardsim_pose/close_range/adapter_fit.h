@@ -14,6 +14,7 @@
 
 #include <Eigen/Geometry>
 
+#include "ardsim_description/frames.h"
 #include "ardsim_pose/pose_types.h"
 
 namespace ardsim_pose {
@@ -45,6 +46,10 @@ struct AdapterGeometry {
 
 // The ISS geometry with its T_target_port.
 AdapterGeometry issAdapterGeometry();
+// Hubble's soft-capture mechanism (the same IDSS ring, petals and reflectors; the aft bulkhead instead of a
+// hatch, no centreline target) with its T_target_port.
+AdapterGeometry hubbleAdapterGeometry();
+AdapterGeometry adapterGeometry(ardsim_description::TargetKind kind);
 
 struct AdapterFitOptions {
   // The sensor's calibrated detector walk: saturated returns (intensity 1) read short by this much
