@@ -11,6 +11,11 @@ void validate(const PoseConfig& c) {
   if (c.method != "icp" && c.method != "auto" && c.method != "ring" && c.method != "pyramid")
     throw std::invalid_argument("method = '" + c.method + "' is not allowed: icp, auto, ring or pyramid");
   close_range::validate(c.mode);
+  // The pyramid's cells, sized for the ring at 12 m and nearer, gave Hubble poses 7 cm off from 15.5 m (gtest
+  // CloseRangeHubble): a clear error, not a wrong pose.
+  if (c.mode.close_method == EstimateMethod::kPyramid && c.mode.close_enter_range_m > 12.0)
+    throw std::invalid_argument("mode/close_enter_range_m = " + std::to_string(c.mode.close_enter_range_m) +
+                                " is out of range with mode/close_method pyramid: <= 12");
   ardsim_lidar::validate(c.sensor);
   validate(c.model);
   validate(c.visibility);
@@ -23,6 +28,14 @@ void applyTargetDefaults(PoseConfig* config) {
   const bool hubble = config->target == ardsim_description::TargetKind::kHubble;
   config->model.spacing_at_port_m = hubble ? 0.015 : defaults.model.spacing_at_port_m;
   config->icp.max_points = hubble ? 2500 : defaults.icp.max_points;
+  // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.1-0.4 deg
+  // RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
+  // fills a quarter of the view): the close-range method takes over there (10-20 m: 0.3-0.6 cm, 0.05-0.10
+  // deg; from 16 m: 1.2-1.6 cm, 0.08-0.31 deg; from 30 m its roll, on 4-pixel reflectors and petals, was 0.9
+  // deg off). With close_method pyramid set these back to the ISS's (validate: at most 12 m).
+  config->mode.close_enter_range_m = hubble ? 20.0 : defaults.mode.close_enter_range_m;
+  config->mode.close_exit_range_m = hubble ? 22.0 : defaults.mode.close_exit_range_m;
+  config->mode.close_enter_fill = hubble ? 0.25 : defaults.mode.close_enter_fill;
 }
 
 std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::TargetKind kind,

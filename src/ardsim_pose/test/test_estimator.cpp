@@ -1,12 +1,15 @@
 // The estimator facade (PoseEstimator) with scripted methods: the median filter on a steady approach, and
-// what the motion prediction learns from TRACKING, DEGRADED and acquisition estimates.
+// what the motion prediction learns from TRACKING, DEGRADED and acquisition estimates; the per-target config.
 #include <cmath>
 #include <map>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "ardsim_pose/estimator_factory.h"
 #include "ardsim_pose/pose_estimator.h"
 
 namespace ardsim_pose {
@@ -152,6 +155,29 @@ TEST(PoseEstimatorPrediction, AnUnobservedBoresightRotationIsNoMotion) {
   const Eigen::Vector3d turn_deg = turn.angle() * turn.axis() * 180.0 / M_PI;
   EXPECT_NEAR(turn_deg.z(), 0.0, 1e-3);
   EXPECT_NEAR(std::abs(turn_deg.x()), 0.5, 0.02);
+}
+
+// Hubble hands over to the close-range method at 20 m; the pyramid method gave poses 7 cm off beyond 12 m, so
+// choosing it there is an error at start that names the parameter.
+TEST(PoseConfigTargets, PyramidBeyondTwelveMetresIsRefused) {
+  PoseConfig hubble;
+  hubble.target = ardsim_description::TargetKind::kHubble;
+  applyTargetDefaults(&hubble);
+  EXPECT_DOUBLE_EQ(hubble.mode.close_enter_range_m, 20.0);
+  EXPECT_NO_THROW(validate(hubble));
+  hubble.mode.close_method = EstimateMethod::kPyramid;
+  try {
+    validate(hubble);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("mode/close_enter_range_m = 20"), std::string::npos) << e.what();
+  }
+  hubble.mode.close_enter_range_m = 12.0;
+  EXPECT_NO_THROW(validate(hubble));
+  PoseConfig iss;
+  applyTargetDefaults(&iss);
+  iss.mode.close_method = EstimateMethod::kPyramid;
+  EXPECT_NO_THROW(validate(iss));
 }
 
 }  // namespace
