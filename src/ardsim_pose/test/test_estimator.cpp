@@ -93,6 +93,23 @@ class MotionScript : public PoseMethod {
   std::map<int, Step> steps_;
 };
 
+// The prediction each of frames 0 .. frames-1 was given by an estimator over MotionScript(steps).
+std::map<int, Eigen::Isometry3d> predictionsOver(std::map<int, MotionScript::Step> steps, int frames) {
+  auto script = std::make_unique<MotionScript>(std::move(steps));
+  MotionScript* probe = script.get();
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::move(script);
+  PoseEstimator estimator(EstimatorOptions{}, std::move(methods),
+                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
+  estimator.setPrior(MotionScript::truth(0));
+  OrganizedCloud cloud;
+  for (int frame = 0; frame < frames; ++frame) {
+    cloud.stamp_s = 0.1 * frame;
+    estimator.process(cloud);
+  }
+  return probe->predictions;
+}
+
 double angleDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
 }
@@ -102,28 +119,17 @@ TEST(PoseEstimatorPrediction, DegradedKeepsTheLinearVelocityAcquisitionResetsIt)
   std::map<int, Step> steps;
   steps[5] = Step{EstimateStatus::kDegraded, false, true};  // tracking, but degraded
   steps[9] = Step{EstimateStatus::kDegraded, true, true};   // an acquisition estimate
-  auto script = std::make_unique<MotionScript>(steps);
-  MotionScript* probe = script.get();
-  PoseEstimator::Methods methods;
-  methods[EstimateMethod::kIcp] = std::move(script);
-  PoseEstimator estimator(EstimatorOptions{}, std::move(methods),
-                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
-  estimator.setPrior(MotionScript::truth(0));
-  OrganizedCloud cloud;
-  for (int frame = 0; frame < 13; ++frame) {
-    cloud.stamp_s = 0.1 * frame;
-    estimator.process(cloud);
-  }
+  const std::map<int, Eigen::Isometry3d> predictions = predictionsOver(steps, 13);
   auto position_error = [&](int frame) {
-    return (probe->predictions.at(frame).translation() - MotionScript::truth(frame).translation()).norm();
+    return (predictions.at(frame).translation() - MotionScript::truth(frame).translation()).norm();
   };
   // Learnt from TRACKING pairs: the next frame predicted exactly.
   EXPECT_LT(position_error(5), 1e-9);
-  EXPECT_LT(angleDeg(probe->predictions.at(5), MotionScript::truth(5)), 1e-6);
+  EXPECT_LT(angleDeg(predictions.at(5), MotionScript::truth(5)), 1e-6);
   // After the DEGRADED frame: the linear velocity kept (it was reset before: 0.5 m off), the angular one
   // dropped (the prediction keeps frame 5's attitude).
   EXPECT_LT(position_error(6), 1e-9);
-  EXPECT_NEAR(angleDeg(probe->predictions.at(6), MotionScript::truth(5)), 0.0, 1e-6);
+  EXPECT_NEAR(angleDeg(predictions.at(6), MotionScript::truth(5)), 0.0, 1e-6);
   // After the acquisition estimate: no velocity at all, the prediction is that estimate; so after the next
   // (TRACKING, but paired with the acquisition's).
   EXPECT_NEAR(position_error(10), 0.5, 1e-9);
@@ -136,21 +142,10 @@ TEST(PoseEstimatorPrediction, AnUnobservedBoresightRotationIsNoMotion) {
   using Step = MotionScript::Step;
   std::map<int, Step> steps;
   for (int frame = 0; frame < 6; ++frame) steps[frame] = Step{EstimateStatus::kTracking, false, false};
-  auto script = std::make_unique<MotionScript>(steps);
-  MotionScript* probe = script.get();
-  PoseEstimator::Methods methods;
-  methods[EstimateMethod::kIcp] = std::move(script);
-  PoseEstimator estimator(EstimatorOptions{}, std::move(methods),
-                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
-  estimator.setPrior(MotionScript::truth(0));
-  OrganizedCloud cloud;
-  for (int frame = 0; frame < 6; ++frame) {
-    cloud.stamp_s = 0.1 * frame;
-    estimator.process(cloud);
-  }
+  const std::map<int, Eigen::Isometry3d> predictions = predictionsOver(steps, 6);
   // The turn about lidar x is extrapolated, the one about the boresight (held by the method) is not. (The
   // prediction's turn from frame 4 is the rotation vector's x part of one frame's turn.)
-  const Eigen::Matrix3d R = probe->predictions.at(5).linear() * MotionScript::truth(4).linear().transpose();
+  const Eigen::Matrix3d R = predictions.at(5).linear() * MotionScript::truth(4).linear().transpose();
   const Eigen::AngleAxisd turn(R);
   const Eigen::Vector3d turn_deg = turn.angle() * turn.axis() * 180.0 / M_PI;
   EXPECT_NEAR(turn_deg.z(), 0.0, 1e-3);
