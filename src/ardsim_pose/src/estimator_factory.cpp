@@ -28,8 +28,8 @@ void applyTargetDefaults(PoseConfig* config) {
   const bool hubble = config->target == ardsim_description::TargetKind::kHubble;
   config->model.spacing_at_port_m = hubble ? 0.015 : defaults.model.spacing_at_port_m;
   config->icp.max_points = hubble ? 2500 : defaults.icp.max_points;
-  // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.1-0.4 deg
-  // RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
+  // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43
+  // deg RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
   // fills a quarter of the view): the close-range method takes over there (10-20 m: 0.3-0.6 cm, 0.05-0.10
   // deg; from 16 m: 1.2-1.6 cm, 0.08-0.31 deg; from 30 m its roll, on 4-pixel reflectors and petals, was 0.9
   // deg off). With close_method pyramid set these back to the ISS's (validate: at most 12 m).
@@ -56,19 +56,14 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
   PoseEstimator::Methods methods;
   methods[EstimateMethod::kIcp] = std::make_unique<IcpTracker>(
       std::move(model), ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
+  const close_range::AdapterGeometry geometry = close_range::adapterGeometry(config.target);
+  methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, config.ring);
+  methods[EstimateMethod::kPyramid] = std::make_unique<close_range::PyramidMethod>(geometry, config.pyramid);
   std::unique_ptr<MethodSelector> selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp);
-  {
-    const close_range::AdapterGeometry geometry = close_range::adapterGeometry(config.target);
-    methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, config.ring);
-    methods[EstimateMethod::kPyramid] =
-        std::make_unique<close_range::PyramidMethod>(geometry, config.pyramid);
-    if (config.method == "ring") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kRing);
-    if (config.method == "pyramid")
-      selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kPyramid);
-    if (config.method == "auto") {
-      selector = std::make_unique<close_range::ModeSelector>(config.mode, geometry.T_target_port);
-    }
-  }
+  if (config.method == "ring") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kRing);
+  if (config.method == "pyramid") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kPyramid);
+  if (config.method == "auto")
+    selector = std::make_unique<close_range::ModeSelector>(config.mode, geometry.T_target_port);
   return std::make_unique<PoseEstimator>(config.estimator, std::move(methods), std::move(selector));
 }
 
