@@ -137,6 +137,19 @@ TEST_P(CloseRangeGoals, FromSevenMetresToContact) {
   EXPECT_GE(sweep.roll_observed, sweep.frames / 2);
 }
 
+// At port range `range`, frame `index` of a sweep: tilts about both axes and lateral offsets up to tilt_deg
+// and lateral_m, a roll up to 25 deg, varying from frame to frame.
+ApproachState disturbedState(double range, int index, double tilt_deg, double lateral_m) {
+  ApproachState s;
+  s.port_range_m = range;
+  s.tilt_y_deg = tilt_deg * std::sin(1.3 * index);
+  s.tilt_z_deg = tilt_deg * std::cos(1.7 * index);
+  s.lateral_y_m = lateral_m * std::sin(0.9 * index);
+  s.lateral_z_m = lateral_m * std::cos(1.1 * index);
+  s.roll_deg = 25.0 * std::sin(2.1 * index);
+  return s;
+}
+
 // From 7.5 to 11.5 m (the hand-over from ICP is at 12 m) the three peripheral reflector targets are whole in
 // the view: the boresight angle from their discs (1.125 m out) is several times finer than from the petals
 // (0.26-0.40 m). The prediction is 8 deg off in roll, so each frame's measurement is taken as it is (no
@@ -148,13 +161,7 @@ TEST(CloseRangeReflectors, BoresightAngleFromOneFrame) {
   double roll_sq = 0.0, roll_max_deg = 0.0;
   for (double range : {7.5, 8.5, 9.5, 10.5, 11.5}) {
     for (int variant = 0; variant < 4; ++variant, ++index) {
-      ApproachState s;
-      s.port_range_m = range;
-      s.tilt_y_deg = 2.0 * std::sin(1.3 * index);
-      s.tilt_z_deg = 2.0 * std::cos(1.7 * index);
-      s.lateral_y_m = 0.05 * std::sin(0.9 * index);
-      s.lateral_z_m = 0.05 * std::cos(1.1 * index);
-      s.roll_deg = 25.0 * std::sin(2.1 * index);
+      const ApproachState s = disturbedState(range, index, 2.0, 0.05);
       const Eigen::Isometry3d truth = testing::T_lidar_target(s);
       const PoseResult result = estimator->estimate(renderer.render(truth, index), predictionFrom(s));
       ASSERT_NE(result.status, EstimateStatus::kLost) << "range " << range << ": " << result.reason;
@@ -193,13 +200,7 @@ TEST_P(CloseRangeHubble, FromTheHandOverToOneAndAHalfMetres) {
   double lateral_max_m = 0.0, range_max_m = 0.0, tilt_sq = 0.0, roll_max_deg = 0.0;
   for (double range : ranges) {
     for (int variant = 0; variant < 3; ++variant, ++index) {
-      ApproachState s;
-      s.port_range_m = range;
-      s.tilt_y_deg = 3.0 * std::sin(1.3 * index);
-      s.tilt_z_deg = 3.0 * std::cos(1.7 * index);
-      s.lateral_y_m = 0.06 * std::sin(0.9 * index);
-      s.lateral_z_m = 0.06 * std::cos(1.1 * index);
-      s.roll_deg = 25.0 * std::sin(2.1 * index);
+      const ApproachState s = disturbedState(range, index, 3.0, 0.06);
       const Eigen::Isometry3d truth = testing::T_lidar_target(s, TargetKind::kHubble);
       ApproachState predicted = s;
       predicted.lateral_y_m += 0.03;
