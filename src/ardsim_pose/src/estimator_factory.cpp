@@ -36,6 +36,13 @@ void applyTargetDefaults(PoseConfig* config) {
   config->mode.close_enter_range_m = hubble ? 20.0 : defaults.mode.close_enter_range_m;
   config->mode.close_exit_range_m = hubble ? 22.0 : defaults.mode.close_exit_range_m;
   config->mode.close_enter_fill = hubble ? 0.25 : defaults.mode.close_enter_fill;
+  // Hubble's port from 30 m in is placed by the ring (ICP's ~2 cm become a few mm), its tilt down to 10 m by
+  // ICP (the ring's ~0.05 deg become ~0.02): the composite pose (EstimatorOptions). The ISS meets its goals
+  // with either method alone: off.
+  config->estimator.composite_min_port_range_m =
+      hubble ? 10.0 : defaults.estimator.composite_min_port_range_m;
+  config->estimator.composite_max_port_range_m =
+      hubble ? 30.0 : defaults.estimator.composite_max_port_range_m;
 }
 
 std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::TargetKind kind,
@@ -62,9 +69,16 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
   std::unique_ptr<MethodSelector> selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp);
   if (config.method == "ring") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kRing);
   if (config.method == "pyramid") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kPyramid);
-  if (config.method == "auto")
+  EstimatorOptions estimator = config.estimator;
+  if (config.method == "auto") {
     selector = std::make_unique<close_range::ModeSelector>(config.mode, geometry.T_target_port);
-  return std::make_unique<PoseEstimator>(config.estimator, std::move(methods), std::move(selector));
+  } else {
+    // One method asked for: that method's pose alone.
+    estimator.composite_min_port_range_m = 0.0;
+    estimator.composite_max_port_range_m = 0.0;
+  }
+  return std::make_unique<PoseEstimator>(estimator, std::move(methods), std::move(selector),
+                                         geometry.T_target_port);
 }
 
 }  // namespace ardsim_pose

@@ -43,14 +43,49 @@ void validate(const EstimatorOptions& o) {
   if (!(std::isfinite(o.max_prediction_gap_s) && o.max_prediction_gap_s >= 0.0))
     throw std::invalid_argument("max_prediction_gap_s = " + std::to_string(o.max_prediction_gap_s) +
                                 " is out of range: >= 0");
+  const bool composite_off = o.composite_min_port_range_m == 0.0 && o.composite_max_port_range_m == 0.0;
+  if (!composite_off && !(o.composite_min_port_range_m >= 0.0 && o.composite_min_port_range_m <= 1000.0))
+    throw std::invalid_argument(
+        "estimator/composite_min_port_range_m = " + std::to_string(o.composite_min_port_range_m) +
+        " is out of range: 0 .. 1000 (both 0: off)");
+  if (!composite_off && !(o.composite_max_port_range_m > o.composite_min_port_range_m &&
+                          o.composite_max_port_range_m <= 1000.0))
+    throw std::invalid_argument(
+        "estimator/composite_max_port_range_m = " + std::to_string(o.composite_max_port_range_m) +
+        " is out of range: > composite_min_port_range_m .. 1000 (both 0: off)");
 }
 
 PoseEstimator::PoseEstimator(const EstimatorOptions& options, Methods methods,
-                             std::unique_ptr<MethodSelector> selector)
-    : options_(options), methods_(std::move(methods)), selector_(std::move(selector)) {
+                             std::unique_ptr<MethodSelector> selector, const Eigen::Isometry3d& T_target_port)
+    : options_(options),
+      methods_(std::move(methods)),
+      selector_(std::move(selector)),
+      T_target_port_(T_target_port) {
   validate(options_);
   if (methods_.empty()) throw std::invalid_argument("PoseEstimator: no pose methods");
   if (!selector_) throw std::invalid_argument("PoseEstimator: no method selector");
+  if (options_.composite_max_port_range_m > 0.0 &&
+      (!methods_.count(EstimateMethod::kIcp) || !methods_.count(EstimateMethod::kRing)))
+    throw std::invalid_argument("PoseEstimator: the composite pose needs the ICP and ring methods");
+}
+
+bool PoseEstimator::compositeAt(const Eigen::Isometry3d& T_lidar_target_predicted) const {
+  const double port_range_m = (T_lidar_target_predicted * T_target_port_.translation()).norm();
+  return port_range_m >= options_.composite_min_port_range_m &&
+         port_range_m < options_.composite_max_port_range_m;
+}
+
+void PoseEstimator::compose(const PoseResult& icp, const PoseResult& ring, PoseResult* result) const {
+  // The rotation from the result to ICP's, as a rotation vector in lidar axes: its x and y (across the
+  // boresight, lidar z) turn the result's attitude; its z, the rotation about the line of sight, stays the
+  // result's. Then the target moves so that its port lies where the ring put it.
+  const Eigen::Vector3d turn =
+      rotationVector(icp.T_lidar_target.linear() * result->T_lidar_target.linear().transpose());
+  const Eigen::Matrix3d R =
+      rotationOf(Eigen::Vector3d(turn.x(), turn.y(), 0.0)) * result->T_lidar_target.linear();
+  const Eigen::Vector3d port_m = ring.T_lidar_target * T_target_port_.translation();
+  result->T_lidar_target.linear() = R;
+  result->T_lidar_target.translation() = port_m - R * T_target_port_.translation();
 }
 
 void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
@@ -63,6 +98,7 @@ void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
   recent_.clear();
   for (auto& method : methods_) method.second->reset();
   selector_->reset();
+  icp_second_lost_ = false;
 }
 
 Eigen::Isometry3d PoseEstimator::predict(double stamp_s) const {
@@ -177,15 +213,38 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
     out.result.T_lidar_target = input.T_lidar_target_predicted;
   } else {
     out.result = method->second->estimate(cloud, input.T_lidar_target_predicted);
+    if (chosen == EstimateMethod::kIcp) icp_second_lost_ = false;
+    // Other methods run on the same frame and prediction, each at most once.
+    std::map<EstimateMethod, PoseResult> others;
+    auto other = [&](EstimateMethod m) -> const PoseResult& {
+      auto found = others.find(m);
+      if (found == others.end())
+        found = others.emplace(m, methods_.at(m)->estimate(cloud, input.T_lidar_target_predicted)).first;
+      return found->second;
+    };
     // A hand-over between methods: the old method's estimate blended into the new one's over a few frames.
     EstimateMethod from = chosen;
     double weight = 1.0;
-    const auto old = selector_->blending(&from, &weight) ? methods_.find(from) : methods_.end();
-    if (old != methods_.end() && from != chosen && out.result.status != EstimateStatus::kLost) {
-      const PoseResult previous_method = old->second->estimate(cloud, input.T_lidar_target_predicted);
+    if (selector_->blending(&from, &weight) && methods_.count(from) && from != chosen &&
+        out.result.status != EstimateStatus::kLost) {
+      const PoseResult& previous_method = other(from);
       if (previous_method.status != EstimateStatus::kLost) {
         out.result.T_lidar_target =
             close_range::blendPoses(previous_method.T_lidar_target, out.result.T_lidar_target, weight);
+      }
+    }
+    const bool composite = options_.composite_max_port_range_m > 0.0 &&
+                           (chosen == EstimateMethod::kIcp || chosen == EstimateMethod::kRing) &&
+                           out.result.status != EstimateStatus::kLost &&
+                           compositeAt(input.T_lidar_target_predicted);
+    if (composite && (chosen == EstimateMethod::kIcp || !icp_second_lost_)) {
+      const PoseResult& icp = chosen == EstimateMethod::kIcp ? out.result : other(EstimateMethod::kIcp);
+      const PoseResult& ring = chosen == EstimateMethod::kRing ? out.result : other(EstimateMethod::kRing);
+      if (chosen != EstimateMethod::kIcp) icp_second_lost_ = icp.status == EstimateStatus::kLost;
+      // A DEGRADED ICP still gives the tilt (most often "not converged": the roll creeping, Hubble end-on); a
+      // DEGRADED ring (the lateral position from a small centreline target) no port position.
+      if (icp.status != EstimateStatus::kLost && ring.status == EstimateStatus::kTracking) {
+        compose(icp, ring, &out.result);
       }
     }
   }

@@ -175,5 +175,182 @@ TEST(PoseConfigTargets, PyramidBeyondTwelveMetresIsRefused) {
   EXPECT_NO_THROW(validate(iss));
 }
 
+// The composite pose: a target whose port lies 6 m from its origin, 20 m out; "ICP" with its port 2 cm off
+// and its attitude turned across and about the boresight, "the ring" with its port 1 mm off and a
+// different turn. Per frame a scripted selection and statuses.
+Eigen::Vector3d rotationVectorOf(const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd turn(R);
+  return turn.angle() * turn.axis();
+}
+
+Eigen::Matrix3d turnDeg(double x, double y, double z) {
+  const Eigen::Vector3d r = Eigen::Vector3d(x, y, z) * M_PI / 180.0;
+  return Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix();
+}
+
+Eigen::Isometry3d portTarget() {
+  Eigen::Isometry3d T_target_port = Eigen::Isometry3d::Identity();
+  T_target_port.translation() = Eigen::Vector3d(-6.0, 0.4, 0.2);
+  return T_target_port;
+}
+
+Eigen::Isometry3d compositeTruth() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = turnDeg(3.0, -2.0, 40.0);
+  T.translation() = Eigen::Vector3d(0.3, -0.2, 0.0);
+  T.translation().z() = 20.0 - (T * portTarget().translation()).z() + T.translation().z();
+  return T;
+}
+
+// The truth turned by R (lidar axes) about its port, the port then moved by offset.
+Eigen::Isometry3d offTruth(const Eigen::Matrix3d& R, const Eigen::Vector3d& offset_m) {
+  const Eigen::Isometry3d truth = compositeTruth();
+  const Eigen::Vector3d port = truth * portTarget().translation();
+  Eigen::Isometry3d T = truth;
+  T.linear() = R * truth.linear();
+  T.translation() = port + offset_m - T.linear() * portTarget().translation();
+  return T;
+}
+
+class FixedPoseMethod : public PoseMethod {
+ public:
+  explicit FixedPoseMethod(const Eigen::Isometry3d& T) : T_(T) {}
+  PoseResult estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d&) override {
+    ++calls;
+    PoseResult result;
+    const int frame = static_cast<int>(std::lround(cloud.stamp_s * 10.0));
+    result.status = status.count(frame) ? status.at(frame) : EstimateStatus::kTracking;
+    result.T_lidar_target = T_;
+    return result;
+  }
+  void reset() override {}
+  std::map<int, EstimateStatus> status;
+  int calls = 0;
+
+ private:
+  Eigen::Isometry3d T_;
+};
+
+class ScriptedSelector : public MethodSelector {
+ public:
+  explicit ScriptedSelector(std::map<int, EstimateMethod> chosen) : chosen_(std::move(chosen)) {}
+  EstimateMethod select(const SelectionInput& input) override {
+    return chosen_.at(static_cast<int>(std::lround(input.cloud->stamp_s * 10.0)));
+  }
+
+ private:
+  std::map<int, EstimateMethod> chosen_;
+};
+
+TEST(PoseEstimatorComposite, PortFromTheRingTiltFromIcpRollFromTheSelected) {
+  const Eigen::Matrix3d R_icp = turnDeg(0.02, -0.03, 0.4), R_ring = turnDeg(0.12, 0.09, -0.2);
+  const Eigen::Isometry3d T_icp = offTruth(R_icp, Eigen::Vector3d(0.02, -0.015, 0.01));
+  const Eigen::Isometry3d T_ring = offTruth(R_ring, Eigen::Vector3d(0.001, 0.0, -0.001));
+  auto icp = std::make_unique<FixedPoseMethod>(T_icp);
+  auto ring = std::make_unique<FixedPoseMethod>(T_ring);
+  FixedPoseMethod* icp_probe = icp.get();
+  FixedPoseMethod* ring_probe = ring.get();
+  // Frame 3: the ring DEGRADED; frame 5: ICP LOST as the second method, so not run again until selected.
+  ring_probe->status[3] = EstimateStatus::kDegraded;
+  icp_probe->status[5] = EstimateStatus::kLost;
+  const EstimateMethod kIcp = EstimateMethod::kIcp, kRing = EstimateMethod::kRing;
+  std::map<int, EstimateMethod> chosen = {{0, kIcp},  {1, kIcp},  {2, kRing}, {3, kIcp}, {4, kRing},
+                                          {5, kRing}, {6, kRing}, {7, kIcp},  {8, kRing}};
+  PoseEstimator::Methods methods;
+  methods[kIcp] = std::move(icp);
+  methods[kRing] = std::move(ring);
+  EstimatorOptions options;
+  options.composite_min_port_range_m = 10.0;
+  options.composite_max_port_range_m = 30.0;
+  PoseEstimator estimator(options, std::move(methods), std::make_unique<ScriptedSelector>(chosen),
+                          portTarget());
+  estimator.setPrior(compositeTruth());
+  const Eigen::Vector3d ring_port = T_ring * portTarget().translation();
+  OrganizedCloud cloud;
+  std::map<int, int> icp_calls;
+  for (int frame = 0; frame < 9; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    cloud.stamp_s = 0.1 * frame;
+    const int calls_before = icp_probe->calls;
+    const Eigen::Isometry3d T = estimator.process(cloud).result.T_lidar_target;
+    icp_calls[frame] = icp_probe->calls - calls_before;
+    const Eigen::Vector3d port = T * portTarget().translation();
+    const Eigen::Vector3d from_icp_deg =
+        rotationVectorOf(T.linear() * T_icp.linear().transpose()) * 180 / M_PI;
+    const Eigen::Vector3d from_ring_deg =
+        rotationVectorOf(T.linear() * T_ring.linear().transpose()) * 180 / M_PI;
+    const bool composite = frame != 3 && frame != 5 && frame != 6;
+    if (composite) {
+      EXPECT_LT((port - ring_port).norm(), 1e-9);
+      // Tilt as ICP's (up to the second order of the small turns), roll as the selected method's.
+      EXPECT_LT(from_icp_deg.head<2>().norm(), 2e-3);
+      if (chosen.at(frame) == kIcp) {
+        EXPECT_LT(from_icp_deg.norm(), 1e-9);
+      } else {
+        EXPECT_LT(std::abs(from_ring_deg.z()), 1e-9);
+      }
+    } else {
+      // The selected method's pose as it is: the ring DEGRADED (3), ICP LOST (5) and not run after (6).
+      const Eigen::Isometry3d& selected = chosen.at(frame) == kIcp ? T_icp : T_ring;
+      EXPECT_LT((T.translation() - selected.translation()).norm(), 1e-9);
+      EXPECT_LT(rotationVectorOf(T.linear() * selected.linear().transpose()).norm(), 1e-9);
+    }
+  }
+  EXPECT_EQ(icp_calls[5], 1);
+  EXPECT_EQ(icp_calls[6], 0);
+  EXPECT_EQ(icp_calls[7], 1);  // selected: tracking again, and the second method after
+  EXPECT_EQ(icp_calls[8], 1);
+  // The composite's port 1 mm off (the ring's), ICP's 2.7 cm: what it is for.
+  EXPECT_GT((T_icp * portTarget().translation() - ring_port).norm(), 0.02);
+}
+
+TEST(PoseEstimatorComposite, OutsideItsBandTheSelectedMethodAlone) {
+  auto icp =
+      std::make_unique<FixedPoseMethod>(offTruth(turnDeg(0.02, -0.03, 0.4), Eigen::Vector3d(0.02, 0, 0)));
+  auto ring = std::make_unique<FixedPoseMethod>(offTruth(turnDeg(0.12, 0.09, -0.2), Eigen::Vector3d::Zero()));
+  FixedPoseMethod* ring_probe = ring.get();
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::move(icp);
+  methods[EstimateMethod::kRing] = std::move(ring);
+  EstimatorOptions options;
+  options.composite_min_port_range_m = 25.0;  // the truth's port is 20 m out
+  options.composite_max_port_range_m = 30.0;
+  PoseEstimator estimator(options, std::move(methods),
+                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp), portTarget());
+  estimator.setPrior(compositeTruth());
+  OrganizedCloud cloud;
+  estimator.process(cloud);
+  EXPECT_EQ(ring_probe->calls, 0);
+}
+
+TEST(PoseEstimatorComposite, BadBandOrMissingMethodIsRefused) {
+  EstimatorOptions options;
+  options.composite_min_port_range_m = 30.0;
+  options.composite_max_port_range_m = 10.0;
+  try {
+    validate(options);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("estimator/composite_max_port_range_m = 10"), std::string::npos)
+        << e.what();
+  }
+  options.composite_max_port_range_m = 40.0;
+  EXPECT_NO_THROW(validate(options));
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::make_unique<ScriptedMethod>();
+  EXPECT_THROW(
+      PoseEstimator(options, std::move(methods), std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp)),
+      std::invalid_argument);
+  // By target: Hubble 10-30 m, the ISS off.
+  PoseConfig hubble;
+  hubble.target = ardsim_description::TargetKind::kHubble;
+  applyTargetDefaults(&hubble);
+  EXPECT_DOUBLE_EQ(hubble.estimator.composite_min_port_range_m, 10.0);
+  EXPECT_DOUBLE_EQ(hubble.estimator.composite_max_port_range_m, 30.0);
+  PoseConfig iss;
+  applyTargetDefaults(&iss);
+  EXPECT_DOUBLE_EQ(iss.estimator.composite_max_port_range_m, 0.0);
+}
+
 }  // namespace
 }  // namespace ardsim_pose

@@ -51,6 +51,14 @@ struct EstimatorOptions {
   double velocity_smoothing =
       0.5;  // weight of the new difference in the velocity's exponential smoothing, 0..1
   double max_prediction_gap_s = 2.0;  // a longer gap since the last good estimate: predict without velocity
+  // Composite pose, in the band of predicted lidar-to-port ranges [min, max) (both 0: off; makeEstimator
+  // turns it off unless the method is auto): ICP and the docking-ring method both run on the frame, and the
+  // pose takes the port position from the ring, the tilt across the line of sight from ICP, the rotation
+  // about it from the selected method. Each part from the method that measures it best: on Hubble at
+  // 20-30 m ICP's port position is ~2 cm off, the ring's a few mm; at 10-20 m the ring's tilt is ~0.05 deg
+  // off, ICP's (the whole body, a long lever) ~0.02.
+  double composite_min_port_range_m = 0.0;
+  double composite_max_port_range_m = 0.0;
 };
 void validate(const EstimatorOptions& options);
 
@@ -65,7 +73,10 @@ struct EstimatorOutput {
 class PoseEstimator {
  public:
   using Methods = std::map<EstimateMethod, std::unique_ptr<PoseMethod>>;
-  PoseEstimator(const EstimatorOptions& options, Methods methods, std::unique_ptr<MethodSelector> selector);
+  // T_target_port: where the composite pose's port position is taken (see EstimatorOptions); with the
+  // composite on, methods must hold ICP and the ring method.
+  PoseEstimator(const EstimatorOptions& options, Methods methods, std::unique_ptr<MethodSelector> selector,
+                const Eigen::Isometry3d& T_target_port = Eigen::Isometry3d::Identity());
 
   // The pose to start from (initial estimate or prior); forgets all history and resets the methods.
   void setPrior(const Eigen::Isometry3d& T_lidar_target);
@@ -75,6 +86,10 @@ class PoseEstimator {
 
  private:
   void updateVelocity(const PoseResult& result, double stamp_s);
+  // Whether the composite pose applies at the predicted pose.
+  bool compositeAt(const Eigen::Isometry3d& T_lidar_target_predicted) const;
+  // result with the port position of ring and the tilt across the line of sight of icp.
+  void compose(const PoseResult& icp, const PoseResult& ring, PoseResult* result) const;
   // The filtered pose at stamp_s from (stamp, raw estimate) pairs.
   Eigen::Isometry3d medianOf(const std::deque<std::pair<double, Eigen::Isometry3d>>& recent,
                              double stamp_s) const;
@@ -82,6 +97,10 @@ class PoseEstimator {
   EstimatorOptions options_;
   Methods methods_;
   std::unique_ptr<MethodSelector> selector_;
+  Eigen::Isometry3d T_target_port_;
+  // ICP, once LOST as the composite's second method, would start an acquisition search (tens to hundreds of
+  // ms) on every later frame: it is not run as the second method again until it is selected.
+  bool icp_second_lost_ = false;
   Eigen::Isometry3d prior_ = Eigen::Isometry3d::Identity();
   bool have_good_ = false;  // a TRACKING or DEGRADED estimate since the prior
   Eigen::Isometry3d last_good_ = Eigen::Isometry3d::Identity();

@@ -730,6 +730,7 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
     T_guess.linear() = portRotation(r.n, seed_boresight);
     T_guess.translation() = ok ? r.centre : r.origin;
   }
+  result.reason.clear();  // a first round's failure that the second made good
 
   // 6. Rotation about the boresight: the petals repeat every 120 deg (the first on the port's +y), the
   // cross's arms every 90 deg (on +-y, +-z). Each is a circular mean of k * angle; together they leave one
