@@ -71,6 +71,49 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
       rms(a));
 }
 
+// Hubble in auto from 28 m through the hand-over at 20 m to 18.4 m (port to port; 0.2 m a 0.1 s frame),
+// tilted, offset and rolled a little, from an acquisition at the first frame: the composite pose
+// (EstimatorOptions) takes the port position from the ring method and the tilt from ICP throughout, the
+// hand-over included. ICP alone places Hubble's port ~2 cm off there (its lateral position rests on the rim
+// of the face-on bulkhead), the ring alone tilts ~0.05 deg.
+TEST(CloseRangeHandover, HubbleCompositePortFromTheRingTiltFromIcp) {
+  using ardsim_description::TargetKind;
+  testing::TargetRenderer renderer(true, 13, TargetKind::kHubble);
+  PoseConfig config;
+  config.target = TargetKind::kHubble;
+  applyTargetDefaults(&config);
+  config.method = "auto";
+  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
+  std::vector<double> position_error, tilt_error;
+  double position_max_m = 0.0;
+  const int frames = 49;
+  for (int k = 0; k < frames; ++k) {
+    testing::ApproachState s;
+    s.port_range_m = 28.0 - 0.2 * k;
+    s.tilt_y_deg = 0.8 - 0.016 * k;
+    s.tilt_z_deg = -0.5 + 0.012 * k;
+    s.lateral_y_m = 0.12 - 0.002 * k;
+    s.lateral_z_m = -0.06;
+    s.roll_deg = 3.0;
+    const Eigen::Isometry3d truth = testing::T_lidar_target(s, TargetKind::kHubble);
+    if (k == 0) estimator->setPrior(truth);
+    OrganizedCloud cloud = renderer.render(truth, k);
+    cloud.stamp_s = 0.1 * k;
+    const EstimatorOutput out = estimator->process(cloud);
+    ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
+    const testing::PortError e = testing::portError(out.result.T_lidar_target, truth, TargetKind::kHubble);
+    const double position_m = std::sqrt(e.lateral() * e.lateral() + e.range_m * e.range_m);
+    position_error.push_back(position_m);
+    position_max_m = std::max(position_max_m, position_m);
+    tilt_error.push_back(e.rotation_deg.tail<2>().norm());  // about the port's y and z: across the axis
+  }
+  std::printf("Hubble 28-18.4 m, composite: port position rms %.4f m max %.4f m, tilt rms %.4f deg\n",
+              rms(position_error), position_max_m, rms(tilt_error));
+  EXPECT_LT(rms(position_error), 0.005);
+  EXPECT_LT(position_max_m, 0.01);
+  EXPECT_LT(rms(tilt_error), 0.03);
+}
+
 }  // namespace
 }  // namespace close_range
 }  // namespace ardsim_pose
