@@ -299,7 +299,13 @@ TEST(IssCloseApproach, BoresightRotationHeldNearThePrediction) {
 
 // Hubble end-on from 40 to 30 m, 0.5 m a frame (as approach_poses --target hubble makes them), tracked from
 // the truth: the roll about Hubble's axis is barely observed. Left to wander (10-20 deg a frame) it took
-// frames to LOST ("diverged") and kept the rest DEGRADED, in acquisition at ~100 ms each.
+// frames to LOST ("diverged") and kept the rest DEGRADED, in acquisition at ~100 ms each. Checked directly:
+// no frame LOST, acquisition over within the first frames and never again, every attitude within 0.5 deg.
+// (Until session 10 this counted TRACKING frames instead, at least 10 of 21: 19 with 2500 scan points; with
+// Hubble's 5000 since, 8, the others "not converged in 15 iterations" by a few tenths of a millimetre of the
+// weak directions' creep, and at 0.5 m a frame without a velocity, which only TRACKING pairs teach. Over the
+// 91-frame approach datasets 5000 points give more TRACKING frames than 2500, 58-67 against 48-57, and
+// hubble_hold 1526 against 1323 beyond 30 m.)
 TEST(HubbleApproach, TracksWithoutLosingAFrame) {
   PoseConfig config;
   config.target = TargetKind::kHubble;
@@ -309,18 +315,25 @@ TEST(HubbleApproach, TracksWithoutLosingAFrame) {
   std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
   const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
   ardsim_lidar::LidarFrame frame;
-  int tracking = 0;
+  double attitude_max_deg = 0.0;
+  int tracked_from = -1;  // the first frame past the acquisition
   for (int k = 0; k < 21; ++k) {
     const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, 39.0 - 0.5 * k);
     if (k == 0) estimator->setPrior(truth);
     simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
     const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
     ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    tracking += out.result.status == EstimateStatus::kTracking ? 1 : 0;
+    if (!out.result.acquiring && tracked_from < 0) tracked_from = k;
+    if (tracked_from >= 0) {
+      EXPECT_FALSE(out.result.acquiring) << "frame " << k << " back in acquisition: " << out.result.reason;
+    }
     const PoseErrorValue e = poseError(out.result.T_lidar_target, truth, T_target_port);
     EXPECT_LT(e.port_position_error_m.norm(), 0.1) << "frame " << k;
+    attitude_max_deg = std::max(attitude_max_deg, e.attitude_error_angle_rad * 180.0 / M_PI);
   }
-  EXPECT_GE(tracking, 10);
+  EXPECT_GE(tracked_from, 0);
+  EXPECT_LE(tracked_from, 3);  // acquisition confirmed within the first frames
+  EXPECT_LT(attitude_max_deg, 0.5);
 }
 
 }  // namespace
