@@ -15,10 +15,49 @@ namespace ardsim_pose {
 namespace close_range {
 namespace {
 
+using ardsim_description::TargetKind;
+
 double rms(const std::vector<double>& values) {
   double sum = 0.0;
   for (double v : values) sum += v * v;
   return std::sqrt(sum / values.size());
+}
+
+// An approach with every quantity of the state linear in the frame index.
+struct Sweep {
+  testing::ApproachState first;
+  testing::ApproachState per_frame;
+  int frames = 0;
+  TargetKind kind = TargetKind::kIss;
+};
+
+struct SweepFrame {
+  Eigen::Isometry3d truth;
+  PoseResult result;
+};
+
+// The sweep's frames rendered and estimated in order, 0.1 s apart, from the first frame's truth; fails at a
+// LOST frame.
+void runSweep(const Sweep& sweep, testing::TargetRenderer* renderer, PoseEstimator* estimator,
+              std::vector<SweepFrame>* out) {
+  for (int k = 0; k < sweep.frames; ++k) {
+    testing::ApproachState s;
+    const testing::ApproachState &a = sweep.first, &b = sweep.per_frame;
+    s.port_range_m = a.port_range_m + k * b.port_range_m;
+    s.lateral_y_m = a.lateral_y_m + k * b.lateral_y_m;
+    s.lateral_z_m = a.lateral_z_m + k * b.lateral_z_m;
+    s.tilt_y_deg = a.tilt_y_deg + k * b.tilt_y_deg;
+    s.tilt_z_deg = a.tilt_z_deg + k * b.tilt_z_deg;
+    s.roll_deg = a.roll_deg + k * b.roll_deg;
+    const Eigen::Isometry3d truth = testing::T_lidar_target(s, sweep.kind);
+    if (k == 0) estimator->setPrior(truth);
+    OrganizedCloud cloud = renderer->render(truth, k);
+    cloud.stamp_s = 0.1 * k;
+    const EstimatorOutput estimate = estimator->process(cloud);
+    ASSERT_NE(estimate.result.status, EstimateStatus::kLost)
+        << "frame " << k << ": " << estimate.result.reason;
+    out->push_back({truth, estimate.result});
+  }
 }
 
 TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
@@ -26,25 +65,16 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
   PoseConfig config;
   config.method = "auto";
   std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
+  // Port range 13.5 m to 10.0 m, 0.1 m per 0.1 s frame.
+  const Sweep sweep{{13.5, 0.05, -0.03, 1.5, -1.0, 5.0}, {-0.1, -0.001, 0.0, -0.03, 0.02, 0.0}, 36};
+  std::vector<SweepFrame> run;
+  ASSERT_NO_FATAL_FAILURE(runSweep(sweep, &renderer, estimator.get(), &run));
+  const int frames = sweep.frames;
   std::vector<double> position_error, attitude_error;
   std::vector<EstimateMethod> methods;
-  const int frames = 36;  // port range 13.5 m to 10.0 m, 0.1 m per 0.1 s frame
-  for (int k = 0; k < frames; ++k) {
-    testing::ApproachState s;
-    s.port_range_m = 13.5 - 0.1 * k;
-    s.tilt_y_deg = 1.5 - 0.03 * k;
-    s.tilt_z_deg = -1.0 + 0.02 * k;
-    s.lateral_y_m = 0.05 - 0.001 * k;
-    s.lateral_z_m = -0.03;
-    s.roll_deg = 5.0;
-    const Eigen::Isometry3d truth = testing::T_lidar_target(s);
-    if (k == 0) estimator->setPrior(truth);
-    OrganizedCloud cloud = renderer.render(truth, k);
-    cloud.stamp_s = 0.1 * k;
-    const EstimatorOutput out = estimator->process(cloud);
-    ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    methods.push_back(out.result.method);
-    const testing::PortError e = testing::portError(out.result.T_lidar_target, truth);
+  for (const SweepFrame& f : run) {
+    methods.push_back(f.result.method);
+    const testing::PortError e = testing::portError(f.result.T_lidar_target, f.truth);
     position_error.push_back(std::sqrt(e.lateral() * e.lateral() + e.range_m * e.range_m));
     attitude_error.push_back(e.rotation_deg.norm());
   }
@@ -77,31 +107,20 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
 // hand-over included. ICP alone places Hubble's port ~2 cm off there (its lateral position rests on the rim
 // of the face-on bulkhead), the ring alone tilts ~0.05 deg.
 TEST(CloseRangeHandover, HubbleCompositePortFromTheRingTiltFromIcp) {
-  using ardsim_description::TargetKind;
   testing::TargetRenderer renderer(true, 13, TargetKind::kHubble);
   PoseConfig config;
   config.target = TargetKind::kHubble;
   applyTargetDefaults(&config);
   config.method = "auto";
   std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
+  const Sweep sweep{
+      {28.0, 0.12, -0.06, 0.8, -0.5, 3.0}, {-0.2, -0.002, 0.0, -0.016, 0.012, 0.0}, 49, TargetKind::kHubble};
+  std::vector<SweepFrame> run;
+  ASSERT_NO_FATAL_FAILURE(runSweep(sweep, &renderer, estimator.get(), &run));
   std::vector<double> position_error, tilt_error;
   double position_max_m = 0.0;
-  const int frames = 49;
-  for (int k = 0; k < frames; ++k) {
-    testing::ApproachState s;
-    s.port_range_m = 28.0 - 0.2 * k;
-    s.tilt_y_deg = 0.8 - 0.016 * k;
-    s.tilt_z_deg = -0.5 + 0.012 * k;
-    s.lateral_y_m = 0.12 - 0.002 * k;
-    s.lateral_z_m = -0.06;
-    s.roll_deg = 3.0;
-    const Eigen::Isometry3d truth = testing::T_lidar_target(s, TargetKind::kHubble);
-    if (k == 0) estimator->setPrior(truth);
-    OrganizedCloud cloud = renderer.render(truth, k);
-    cloud.stamp_s = 0.1 * k;
-    const EstimatorOutput out = estimator->process(cloud);
-    ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    const testing::PortError e = testing::portError(out.result.T_lidar_target, truth, TargetKind::kHubble);
+  for (const SweepFrame& f : run) {
+    const testing::PortError e = testing::portError(f.result.T_lidar_target, f.truth, TargetKind::kHubble);
     const double position_m = std::sqrt(e.lateral() * e.lateral() + e.range_m * e.range_m);
     position_error.push_back(position_m);
     position_max_m = std::max(position_max_m, position_m);
