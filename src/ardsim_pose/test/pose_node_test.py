@@ -119,7 +119,8 @@ class PoseInterfaceTest(unittest.TestCase):
         # One node name per case: a _param:= setting stays on the parameter server after its node exits.
         cases = [('_icp/max_points:=3', 'icp/max_points = 3'),
                  ('_mode/close_method:=laser', "mode/close_method = 'laser'"),
-                 ('_mode/close_exit_range_m:=5.0', 'mode/close_exit_range_m = 5')]
+                 ('_mode/close_exit_range_m:=5.0', 'mode/close_exit_range_m = 5'),
+                 ('_estimator/composite_max_port_range_m:=-5.0', 'estimator/composite_max_port_range_m = -5')]
         for case, (setting, named) in enumerate(cases):
             result = subprocess.run(['rosrun', 'ardsim_pose', 'pose_node', '__name:=bad_pose_%d' % case, setting],
                                     capture_output=True, text=True, timeout=120)
