@@ -29,9 +29,9 @@ void applyTargetDefaults(PoseConfig* config) {
   config->model.spacing_at_port_m = hubble ? 0.015 : defaults.model.spacing_at_port_m;
   // Hubble's roll about its axis rests end-on on a few small features (the antenna booms, the soft-capture
   // mechanism's edges): with 2500 points single noisy frames turned it 0.3-1.5 deg, where the boresight prior
-  // then held it (20-30 m band, 9 render seeds x truth / coarse prior, auto: within 0.05 deg in 2 of 18 runs,
-  // worst 1.46 deg RMS); with 5000 (every gated pixel out to ~40 m) in 15 of 18, worst 0.14 deg, at ~11-13
-  // ms a frame instead of 7-9.
+  // then held it (20-30 m band, 13 render seeds x truth / coarse prior, auto: within 0.05 deg in 3 of 26
+  // runs, worst 1.46 deg RMS); with 5000 (every gated pixel out to ~40 m) in 21 of 26, worst 0.94 deg, at
+  // ~11-13 ms a frame instead of 7-9.
   config->icp.max_points = hubble ? 5000 : defaults.icp.max_points;
   // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43
   // deg RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
