@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -215,23 +216,16 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
     out.result = method->second->estimate(cloud, input.T_lidar_target_predicted);
     const PoseResult selected = out.result;  // before a hand-over's blend
     if (chosen == EstimateMethod::kIcp) icp_second_lost_ = false;
-    // Other methods run on the same frame and prediction, each at most once.
-    std::map<EstimateMethod, PoseResult> others;
-    auto other = [&](EstimateMethod m) -> const PoseResult& {
-      auto found = others.find(m);
-      if (found == others.end())
-        found = others.emplace(m, methods_.at(m)->estimate(cloud, input.T_lidar_target_predicted)).first;
-      return found->second;
-    };
     // A hand-over between methods: the old method's estimate blended into the new one's over a few frames.
     EstimateMethod from = chosen;
     double weight = 1.0;
+    std::optional<PoseResult> from_result;  // the old method's estimate of this frame, when it ran
     if (selector_->blending(&from, &weight) && methods_.count(from) && from != chosen &&
         out.result.status != EstimateStatus::kLost) {
-      const PoseResult& previous_method = other(from);
-      if (previous_method.status != EstimateStatus::kLost) {
+      from_result = methods_.at(from)->estimate(cloud, input.T_lidar_target_predicted);
+      if (from_result->status != EstimateStatus::kLost) {
         out.result.T_lidar_target =
-            close_range::blendPoses(previous_method.T_lidar_target, out.result.T_lidar_target, weight);
+            close_range::blendPoses(from_result->T_lidar_target, out.result.T_lidar_target, weight);
       }
     }
     const bool composite = options_.composite_max_port_range_m > 0.0 &&
@@ -244,11 +238,11 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
       // The ring as the second method starts from ICP's estimate of this frame (nearer than the prediction:
       // without a velocity, 0.2 m a frame, it found no faces in its 5 cm band around the prediction). ICP as
       // the second starts from the prediction, as when it is selected (from the ring's estimate: the same
-      // figures on the Hubble approach datasets).
+      // figures on the Hubble approach datasets). A method already run for the blend is not run again.
       const Eigen::Isometry3d& second_start =
           second_method == EstimateMethod::kRing ? selected.T_lidar_target : input.T_lidar_target_predicted;
-      const PoseResult second = others.count(second_method)
-                                    ? others.at(second_method)
+      const PoseResult second = from_result && from == second_method
+                                    ? *from_result
                                     : methods_.at(second_method)->estimate(cloud, second_start);
       const PoseResult& icp = chosen == EstimateMethod::kIcp ? selected : second;
       const PoseResult& ring = chosen == EstimateMethod::kRing ? selected : second;

@@ -56,7 +56,7 @@ struct EstimatorOptions {
   // pose takes the port position from the ring, the tilt across the line of sight from ICP, the rotation
   // about it from the selected method. Each part from the method that measures it best: on Hubble at
   // 20-30 m ICP's port position is ~2 cm off, the ring's a few mm; at 10-20 m the ring's tilt is ~0.05 deg
-  // off, ICP's (the whole body, a long lever) ~0.02.
+  // off, ICP's (the whole body, a long lever) ~0.02. Status, flags and covariance stay the selected method's.
   double composite_min_port_range_m = 0.0;
   double composite_max_port_range_m = 0.0;
 };
