@@ -15,6 +15,12 @@
 namespace ardsim_pose {
 namespace {
 
+// The scripted frames are 0.1 s apart (as the approach datasets): frame k at stamp 0.1 k.
+constexpr double kFramePeriodS = 0.1;
+int frameAt(double stamp_s) {
+  return static_cast<int>(std::lround(stamp_s / kFramePeriodS));
+}
+
 // The target closing along the boresight at 5 m/s (0.5 m a 0.1 s frame, as the approach datasets), with
 // scripted lateral noise and, at one frame, a 0.5 m outlier across the boresight.
 Eigen::Isometry3d truthAt(double stamp_s) {
@@ -29,7 +35,7 @@ class ScriptedMethod : public PoseMethod {
     PoseResult result;
     result.status = EstimateStatus::kTracking;
     result.T_lidar_target = truthAt(cloud.stamp_s);
-    const int frame = static_cast<int>(std::lround(cloud.stamp_s * 10.0));
+    const int frame = frameAt(cloud.stamp_s);
     result.T_lidar_target.translation().x() += frame == 12 ? 0.5 : 0.02 * std::sin(2.3 * frame);
     return result;
   }
@@ -46,7 +52,7 @@ TEST(PoseEstimatorMedianFilter, NeitherLagsASteadyApproachNorPassesAnOutlier) {
   estimator.setPrior(truthAt(0.0));
   OrganizedCloud cloud;
   for (int frame = 0; frame < 30; ++frame) {
-    cloud.stamp_s = 0.1 * frame;
+    cloud.stamp_s = kFramePeriodS * frame;
     const EstimatorOutput out = estimator.process(cloud);
     const Eigen::Vector3d error =
         out.result.T_lidar_target.translation() - truthAt(cloud.stamp_s).translation();
@@ -69,14 +75,14 @@ class MotionScript : public PoseMethod {
   };
   explicit MotionScript(std::map<int, Step> steps) : steps_(std::move(steps)) {}
   static Eigen::Isometry3d truth(int frame) {
-    Eigen::Isometry3d T = truthAt(0.1 * frame);
+    Eigen::Isometry3d T = truthAt(kFramePeriodS * frame);
     const Eigen::Vector3d turn_per_frame_rad = Eigen::Vector3d(0.5, 0.0, 1.0) * M_PI / 180.0;
     T.linear() = Eigen::AngleAxisd(frame * turn_per_frame_rad.norm(), turn_per_frame_rad.normalized())
                      .toRotationMatrix();
     return T;
   }
   PoseResult estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& predicted) override {
-    const int frame = static_cast<int>(std::lround(cloud.stamp_s * 10.0));
+    const int frame = frameAt(cloud.stamp_s);
     predictions[frame] = predicted;
     const Step step = steps_.count(frame) ? steps_.at(frame) : Step{};
     PoseResult result;
@@ -104,7 +110,7 @@ std::map<int, Eigen::Isometry3d> predictionsOver(std::map<int, MotionScript::Ste
   estimator.setPrior(MotionScript::truth(0));
   OrganizedCloud cloud;
   for (int frame = 0; frame < frames; ++frame) {
-    cloud.stamp_s = 0.1 * frame;
+    cloud.stamp_s = kFramePeriodS * frame;
     estimator.process(cloud);
   }
   return probe->predictions;
@@ -218,7 +224,7 @@ class FixedPoseMethod : public PoseMethod {
   PoseResult estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d&) override {
     ++calls;
     PoseResult result;
-    const int frame = static_cast<int>(std::lround(cloud.stamp_s * 10.0));
+    const int frame = frameAt(cloud.stamp_s);
     result.status = status.count(frame) ? status.at(frame) : EstimateStatus::kTracking;
     result.T_lidar_target = T_;
     return result;
@@ -235,7 +241,7 @@ class ScriptedSelector : public MethodSelector {
  public:
   explicit ScriptedSelector(std::map<int, EstimateMethod> chosen) : chosen_(std::move(chosen)) {}
   EstimateMethod select(const SelectionInput& input) override {
-    return chosen_.at(static_cast<int>(std::lround(input.cloud->stamp_s * 10.0)));
+    return chosen_.at(frameAt(input.cloud->stamp_s));
   }
 
  private:
@@ -270,7 +276,7 @@ TEST(PoseEstimatorComposite, PortFromTheRingTiltFromIcpRollFromTheSelected) {
   std::map<int, int> icp_calls;
   for (int frame = 0; frame < 9; ++frame) {
     SCOPED_TRACE("frame " + std::to_string(frame));
-    cloud.stamp_s = 0.1 * frame;
+    cloud.stamp_s = kFramePeriodS * frame;
     const int calls_before = icp_probe->calls;
     const Eigen::Isometry3d T = estimator.process(cloud).result.T_lidar_target;
     icp_calls[frame] = icp_probe->calls - calls_before;
