@@ -269,6 +269,7 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
   candidates_.clear();
   const Eigen::Matrix3f R = T_lidar_target.linear().cast<float>();
   const Eigen::Vector3f t = T_lidar_target.translation().cast<float>();
+  const Eigen::Vector3f eye = -(R.transpose() * t);  // the sensor, target frame
   const float fx = static_cast<float>(intrinsics_.fx);
   const float fy = static_cast<float>(intrinsics_.fy);
   const float cx = static_cast<float>(intrinsics_.cx);
@@ -292,9 +293,10 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
     if (outside) continue;
     for (std::uint32_t i = chunk.begin; i < chunk.end; ++i) {
       const ReferenceModel::Patch& patch = model.patches()[i];
+      // Back face (seen from behind), tested in target coordinates before the transform: half the patches.
+      if (patch.normal.dot(patch.centre - eye) >= 0.0f) continue;
       const Eigen::Vector3f p = R * patch.centre + t;
       if (p.z() < 0.05f) continue;
-      if ((R * patch.normal).dot(p) >= 0.0f) continue;  // back face: seen from behind
       const float inv_z = 1.0f / p.z();
       const float u = fx * p.x() * inv_z + cx;
       const float v = fy * p.y() * inv_z + cy;
