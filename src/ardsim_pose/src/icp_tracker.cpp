@@ -28,6 +28,11 @@ constexpr int kFineIterations = 3;
 // nearestVisible): wide enough that the iterations after the first few stay inside, narrow enough to hold
 // few points.
 constexpr float kNeighbourhoodMarginM = 0.03f;
+// A visibility prediction's grid of visible points (VisiblePointGrid) is built once the nearest-point
+// searches it would answer (the tree's so far and the ones due) times this reach its visible points: binning
+// costs ~7-10 ns a point, a search answered by the grid instead of the tree saves ~0.6-0.9 us, and on the ISS
+// approach dataset 60 left no range band slower than the tree alone (100: acquisition frames 5-10 % slower).
+constexpr int kGridBuildRatio = 60;
 // The coverage and silhouette checks of a final pose take a visibility prediction made at a pose that moves
 // every visible model point less than one of its 4 px cells in the image (they allow a cell or more). (The
 // gate and the crop at the start of an alignment take only one made at exactly their pose: with this
@@ -347,9 +352,11 @@ void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_
   ++visibility_generation_;
   VisibilitySlot& slot = slots_[current_];
   if (serves(slot)) return;
-  slot.predictor.predict(*model_, T, &slot.visible);
+  slot.visible_points = slot.predictor.predict(*model_, T, &slot.visible);
   slot.pose = T;
   slot.valid = true;
+  slot.grid_built = false;
+  slot.tree_searches = 0;
 }
 
 void IcpTracker::markSilhouette(int r) {
@@ -402,6 +409,20 @@ void IcpTracker::gateToSilhouette(const Eigen::Isometry3d& T, double margin_px) 
   if (static_cast<int>(gated_.size()) < options_.min_points) gated_ = valid_;
 }
 
+const VisiblePointGrid* IcpTracker::grid() {
+  VisibilitySlot& slot = slots_[current_];
+  if (!slot.grid_built) {
+    // Worth building once the searches it would answer outweigh binning every visible point.
+    if ((slot.tree_searches + pending_searches_) * kGridBuildRatio < slot.visible_points) {
+      ++slot.tree_searches;
+      return nullptr;
+    }
+    slot.grid.build(*model_, slot.predictor.visiblePatches(), slot.pose, slot.predictor.nearestDepth());
+    slot.grid_built = true;
+  }
+  return &slot.grid;
+}
+
 int IcpTracker::nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, float* distance_sq) {
   Neighbourhood& ball = neighbourhoods_[k];
   if (ball.radius_m > 0.0f) {
@@ -425,8 +446,12 @@ int IcpTracker::nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, f
   }
   ball.centre = q;
   ball.begin = static_cast<std::uint32_t>(neighbourhood_points_.size());
-  const int j = model_->nearestVisibleWithNeighbours(q, gate_sq, visible(), kNeighbourhoodMarginM,
-                                                     distance_sq, &ball.radius_m, &neighbourhood_points_);
+  int j = -1;
+  const VisiblePointGrid* binned = grid();
+  if (binned == nullptr || !binned->nearest(q, gate_sq, &j, distance_sq, kNeighbourhoodMarginM,
+                                            &ball.radius_m, &neighbourhood_points_))
+    j = model_->nearestVisibleWithNeighbours(q, gate_sq, visible(), kNeighbourhoodMarginM, distance_sq,
+                                             &ball.radius_m, &neighbourhood_points_);
   ball.end = static_cast<std::uint32_t>(neighbourhood_points_.size());
   return j;
 }
@@ -457,10 +482,13 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
     const Eigen::Matrix3d R = T.linear();
     correspondences_.clear();
+    pending_searches_ = 0;  // after the first iteration on a prediction, most answers come from the balls
     if (neighbourhood_generation_ != visibility_generation_) {
       neighbourhoods_.assign(scan_.size(), Neighbourhood{});
       neighbourhood_points_.clear();
       neighbourhood_generation_ = visibility_generation_;
+      // Each point searched now, and in the fine stage after a coarse one the rest too.
+      pending_searches_ = static_cast<int>(coarse ? scan_.size() : active_.size());
     }
     const float gate_sq = static_cast<float>(gate * gate);
     std::size_t kept = 0;
@@ -593,14 +621,18 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
   return a;
 }
 
-int IcpTracker::explainedPoints(const Eigen::Isometry3d& T, int stride) const {
+int IcpTracker::explainedPoints(const Eigen::Isometry3d& T, int stride) {
   const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
   const float reach = static_cast<float>(options_.gate_min_m);
   int explained = 0;
+  pending_searches_ = static_cast<int>(scan_.size()) / stride;
   for (std::size_t k = 0; k < scan_.size(); k += stride) {
     const Eigen::Vector3f q = T_target_lidar * scan_[k];
     float distance_sq = 0.0f;
-    const int j = model_->nearestVisible(q, reach * reach, visible(), &distance_sq);
+    int j = -1;
+    const VisiblePointGrid* binned = grid();
+    if (binned == nullptr || !binned->nearest(q, reach * reach, &j, &distance_sq))
+      j = model_->nearestVisible(q, reach * reach, visible(), &distance_sq);
     if (j >= 0 && std::abs(model_->normals()[j].dot(q - model_->points()[j])) < options_.explained_distance_m)
       ++explained;
   }

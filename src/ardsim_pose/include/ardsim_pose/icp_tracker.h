@@ -127,7 +127,7 @@ class IcpTracker : public PoseMethod {
   // Of the hypotheses, each aligned for search_iterations, the one that explains most scan points.
   Alignment bestOf(const std::vector<Eigen::Isometry3d>& hypotheses, double gate_m);
   // Every stride-th scan point within explained_distance_m of the model surface visible in visible_, at T.
-  int explainedPoints(const Eigen::Isometry3d& T, int stride) const;
+  int explainedPoints(const Eigen::Isometry3d& T, int stride);
   // The pose at stamp_s extrapolated at constant velocity from the last two acquisition estimates.
   bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
   double coverage() const;
@@ -182,9 +182,13 @@ class IcpTracker : public PoseMethod {
   // correction (a prediction off by a few pixels, then the estimate back near the last one).
   struct VisibilitySlot {
     VisibilitySlot(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options)
-        : predictor(intrinsics, options) {}
+        : predictor(intrinsics, options), grid(intrinsics, options.margin_px) {}
     VisibilityPredictor predictor;
     std::vector<std::uint8_t> visible;
+    int visible_points = 0;
+    VisiblePointGrid grid;  // of the visible points, built when enough searches are due (IcpTracker::grid)
+    bool grid_built = false;
+    int tree_searches = 0;  // since the prediction, while there is no grid
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     bool valid = false;
   };
@@ -209,6 +213,10 @@ class IcpTracker : public PoseMethod {
   std::vector<std::uint32_t> neighbourhood_points_;  // the balls' model point indices
   int visibility_generation_ = 0;                    // counts the visibility predictions
   int neighbourhood_generation_ = -1;                // the prediction the balls were built with
+  // The visible points of the current visibility prediction binned by pixel, when built or worth building
+  // for the searches so far and pending_searches_ (counted as one more tree search when not: nullptr).
+  const VisiblePointGrid* grid();
+  int pending_searches_ = 0;  // nearest-point searches about to be made with no ball to answer them
   // The nearest visible model point to q (target frame) within the gate for scan_ point k, from its ball
   // when that answers exactly, else from the tree (and a new ball).
   int nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, float* distance_sq);

@@ -4,10 +4,13 @@
 // ROS-free.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
+#include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "ardsim_description/mesh.h"
@@ -42,6 +45,8 @@ class ReferenceModel {
   const std::vector<Eigen::Vector3f>& points() const { return points_; }    // target frame, m
   const std::vector<Eigen::Vector3f>& normals() const { return normals_; }  // unit, outward
   const std::vector<float>& spacing() const { return spacing_; }            // m, per point
+  // The points' x, y and z coordinates as three arrays (vectorized transforms of ranges of points).
+  const Eigen::ArrayXf& coordinates(int axis) const { return coordinates_[axis]; }
 
   // Nearest point with visible[index] != 0 within sqrt(max_distance_sq) of query (target frame); -1 if none.
   int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
@@ -89,6 +94,7 @@ class ReferenceModel {
   std::vector<Eigen::Vector3f> points_;
   std::vector<Eigen::Vector3f> normals_;
   std::vector<float> spacing_;
+  std::array<Eigen::ArrayXf, 3> coordinates_;
   std::vector<Patch> patches_;
   std::vector<Chunk> chunks_;
   std::unique_ptr<KdTree> tree_;
@@ -122,6 +128,8 @@ class VisibilityPredictor {
   float nearestDepth() const { return nearest_depth_; }
   // Cell of a pixel (inside the image).
   int cellOfPixel(int u, int v) const { return (v / options_.cell_px) * grid_width_ + u / options_.cell_px; }
+  // The patches judged visible by the last predict() (their points are the visible ones).
+  const std::vector<std::uint32_t>& visiblePatches() const { return visible_patches_; }
 
  private:
   ardsim_lidar::Intrinsics intrinsics_;
@@ -140,6 +148,45 @@ class VisibilityPredictor {
     float depth;
   };
   std::vector<Candidate> candidates_;
+  std::vector<std::uint32_t> visible_patches_;
+};
+
+// The visible model points binned by the pixels they project to at one pose: an exact nearest-visible-point
+// search that reads a few bins around the query's own instead of descending the KD-tree over every model
+// point (three in four of those near a query are hidden). A point outside the window of bins around the
+// query lies at least a known angle off the query's ray, so at least a known distance away: when the nearest
+// point found in the window is closer than that, it is the nearest of all; otherwise the search says it
+// cannot answer and the caller asks the tree.
+class VisiblePointGrid {
+ public:
+  VisiblePointGrid(const ardsim_lidar::Intrinsics& intrinsics, double margin_px);
+
+  // Bins the points of the patches (target frame) as seen from T_lidar_target.
+  // depth_m: the depth of the nearest predicted surface (the bins' size follows it).
+  void build(const ReferenceModel& model, const std::vector<std::uint32_t>& patches,
+             const Eigen::Isometry3d& T_lidar_target, double depth_m);
+  // The nearest binned point within sqrt(max_distance_sq) of query (target frame; index -1: none) when the
+  // grid can tell exactly (returns true; false: ask the tree). With near: as
+  // ReferenceModel::nearestVisibleWithNeighbours, the ball's radius and the points within it besides.
+  bool nearest(const Eigen::Vector3f& query, float max_distance_sq, int* index, float* distance_sq,
+               float margin_m = 0.0f, float* radius_m = nullptr,
+               std::vector<std::uint32_t>* near = nullptr) const;
+
+ private:
+  ardsim_lidar::Intrinsics intrinsics_;
+  int pad_px_ = 0;
+  int bin_px_ = 1;
+  int bins_wide_ = 0;
+  int bins_high_ = 0;
+  float min_cos_sq_ = 1.0f;  // squared cosine of the off-axis angle of the padded image's corner
+  Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f t_ = Eigen::Vector3f::Zero();
+  std::vector<std::uint32_t> bin_begin_;                       // bins_wide_ x bins_high_ + 1
+  std::vector<Eigen::Vector3f> bin_points_;                    // target frame, bin by bin
+  std::vector<std::uint32_t> bin_index_;                       // their model point indices
+  std::vector<std::int32_t> bin_of_;                           // scratch: bin per point of the patches
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs_;  // scratch: the patches' point ranges
+  Eigen::ArrayXf x_, y_, z_;                                   // scratch
 };
 
 }  // namespace ardsim_pose
