@@ -459,10 +459,11 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
   // no window reaches: they too lie outside it.
   const float range = 0.999f * x.norm();
   const float radians_per_px = min_cos_sq_ / static_cast<float>(std::max(intrinsics_.fx, intrinsics_.fy));
-  thread_local std::vector<std::pair<float, std::uint32_t>> found;  // window points within the gate
+  std::vector<std::pair<float, std::uint32_t>>& found = found_;  // window points that may be in the ball
   found.clear();
   float best_sq = max_distance_sq;
   int best = -1;
+  float ball_limit_sq = max_distance_sq;  // the ball cannot reach past the nearest distance and the margin
   const auto scan = [&](int ua, int ub, int va, int vb) {
     for (int y = va; y <= vb; ++y) {
       const std::size_t row = static_cast<std::size_t>(y + 1) * (bins_wide_ + 2) + 1;  // past the border
@@ -473,11 +474,13 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
           const float diff = query[c] - p[c];
           d += diff * diff;
         }
-        if (!(d < max_distance_sq)) continue;
+        if (!(d < ball_limit_sq)) continue;
         if (near != nullptr) found.push_back({d, bin_index_[k]});
         if (d < best_sq) {
           best_sq = d;
           best = static_cast<int>(bin_index_[k]);
+          const float limit = std::sqrt(d) + margin_m;
+          ball_limit_sq = std::min(max_distance_sq, limit * limit);
         }
       }
     }
@@ -501,8 +504,9 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
     }
     const float edge_px =
         std::min({u - u0 * bin_px_, (u1 + 1) * bin_px_ - u, v - v0 * bin_px_, (v1 + 1) * bin_px_ - v});
-    reach = std::min(range * std::sin(std::min(edge_px * radians_per_px, 1.5707f)),
-                     0.999f * (x.z() - kNearestDepthM));
+    // sin(a) >= a - a^3 / 6 for a >= 0 (a bound, not a libm call, in the hottest loop).
+    const float a = std::min(edge_px * radians_per_px, 1.5707f);
+    reach = std::min(range * (a - a * a * a * (1.0f / 6.0f)), 0.999f * (x.z() - kNearestDepthM));
     exact = exact || best_sq < reach * reach;
     if (exact) {
       // The ball as wide as the tree's (the nearest distance and the margin), where the window allows: a

@@ -181,12 +181,13 @@ class VisiblePointGrid {
   float min_cos_sq_ = 1.0f;  // squared cosine of the off-axis angle of the padded image's corner
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   Eigen::Vector3f t_ = Eigen::Vector3f::Zero();
-  std::vector<std::uint32_t> bin_begin_;                       // bins_wide_ x bins_high_ + 1
-  std::vector<Eigen::Vector3f> bin_points_;                    // target frame, bin by bin
-  std::vector<std::uint32_t> bin_index_;                       // their model point indices
-  std::vector<std::int32_t> bin_of_;                           // scratch: bin per point of the patches
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs_;  // scratch: the patches' point ranges
-  Eigen::ArrayXf x_, y_, z_;                                   // scratch
+  std::vector<std::uint32_t> bin_begin_;                        // bins_wide_ x bins_high_ + 1
+  std::vector<Eigen::Vector3f> bin_points_;                     // target frame, bin by bin
+  std::vector<std::uint32_t> bin_index_;                        // their model point indices
+  std::vector<std::int32_t> bin_of_;                            // scratch: bin per point of the patches
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs_;   // scratch: the patches' point ranges
+  Eigen::ArrayXf x_, y_, z_;                                    // scratch
+  mutable std::vector<std::pair<float, std::uint32_t>> found_;  // scratch of nearest()
 };
 
 }  // namespace ardsim_pose
