@@ -341,20 +341,22 @@ double IcpTracker::imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isom
          (secant * angle + moved.translation().norm() / std::max(near_m, 1e-3));
 }
 
-void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_px) {
+void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_px, bool depth_only) {
   auto serves = [&](const VisibilitySlot& slot) {
-    return slot.valid && (T.matrix() == slot.pose.matrix() ||
-                          (tolerance_px > 0.0 &&
-                           imageMotionPx(slot.pose, T, slot.predictor.nearestDepth()) <= tolerance_px));
+    return slot.valid && (depth_only || !slot.depth_only) &&
+           (T.matrix() == slot.pose.matrix() ||
+            (tolerance_px > 0.0 &&
+             imageMotionPx(slot.pose, T, slot.predictor.nearestDepth()) <= tolerance_px));
   };
   if (serves(slots_[current_])) return;
   current_ = 1 - current_;
   ++visibility_generation_;
   VisibilitySlot& slot = slots_[current_];
   if (serves(slot)) return;
-  slot.visible_points = slot.predictor.predict(*model_, T, &slot.visible);
+  slot.visible_points = slot.predictor.predict(*model_, T, depth_only ? nullptr : &slot.visible);
   slot.pose = T;
   slot.valid = true;
+  slot.depth_only = depth_only;
   slot.grid_built = false;
   slot.tree_searches = 0;
 }
@@ -616,8 +618,8 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
   }
   // The visibility of the final pose, for the coverage and silhouette checks: most tracking frames end
   // within the tolerance of their prediction, or of the one before (the pose of the frame before, when the
-  // prediction was off).
-  predictVisibility(T, kVisibilityTolerancePx);
+  // prediction was off). Tracking needs only its depths; the acquisition search scores the visible points.
+  predictVisibility(T, kVisibilityTolerancePx, tracking);
   return a;
 }
 

@@ -268,7 +268,7 @@ VisibilityPredictor::VisibilityPredictor(const ardsim_lidar::Intrinsics& intrins
 
 int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
                                  std::vector<std::uint8_t>* visible) {
-  visible->assign(model.size(), 0);
+  if (visible != nullptr) visible->assign(model.size(), 0);
   const float inf = std::numeric_limits<float>::infinity();
   depth_.assign(static_cast<std::size_t>(padded_width_) * padded_height_, inf);
   candidates_.clear();
@@ -319,7 +319,7 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
         }
       const int cell_index =
           std::clamp(cv, 0, padded_height_ - 1) * padded_width_ + std::clamp(cu, 0, padded_width_ - 1);
-      candidates_.push_back({i, cell_index, p.z() - patch.radius});
+      if (visible != nullptr) candidates_.push_back({i, cell_index, p.z() - patch.radius});
     }
   }
   int count = 0;

@@ -134,8 +134,9 @@ class IcpTracker : public PoseMethod {
   void alignRange(Eigen::Isometry3d* T);
   // Makes current a visibility prediction at T: one of the two kept (the last two made) when it was made at
   // exactly T or (tolerance_px > 0) at a pose that puts every visible model point within tolerance_px of
-  // where T puts it, else a new one in place of the older.
-  void predictVisibility(const Eigen::Isometry3d& T, double tolerance_px = 0.0);
+  // where T puts it, else a new one in place of the older. depth_only: only its depths are needed (the
+  // coverage and silhouette checks), not the visible points; such a one serves no other request.
+  void predictVisibility(const Eigen::Isometry3d& T, double tolerance_px = 0.0, bool depth_only = false);
   const VisibilityPredictor& visibility() const { return slots_[current_].predictor; }
   const std::vector<std::uint8_t>& visible() const { return slots_[current_].visible; }
   // The norm (m; rotations times the correspondences' lever arm) of the move from T_from to T_to in the weak
@@ -191,6 +192,7 @@ class IcpTracker : public PoseMethod {
     int tree_searches = 0;  // since the prediction, while there is no grid
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     bool valid = false;
+    bool depth_only = false;  // visible and grid not made
   };
   std::array<VisibilitySlot, 2> slots_;
   int current_ = 0;

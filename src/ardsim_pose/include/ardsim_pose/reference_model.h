@@ -115,7 +115,7 @@ class VisibilityPredictor {
   VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options);
 
   // Fills visible (one flag per model point) and the per-cell depth of the nearest predicted surface.
-  // Returns the number of visible points.
+  // Returns the number of visible points. visible nullptr: the depths alone (a third faster), returns 0.
   int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
               std::vector<std::uint8_t>* visible);
 
