@@ -280,6 +280,7 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
   const float cx = static_cast<float>(intrinsics_.cx);
   const float cy = static_cast<float>(intrinsics_.cy);
   const float cell = static_cast<float>(options_.cell_px);
+  const float inv_cell = 1.0f / cell;  // multiplied, not divided, per patch (exact for the default 4 px)
   const float margin = static_cast<float>(options_.margin_px);
   const float u_min = -0.5f - margin, u_max = intrinsics_.width - 0.5f + margin;
   const float v_min = -0.5f - margin, v_max = intrinsics_.height - 0.5f + margin;
@@ -308,10 +309,10 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
       const float radius_px = patch.radius * fx * inv_z;
       if (u + radius_px < u_min || u - radius_px >= u_max || v + radius_px < v_min || v - radius_px >= v_max)
         continue;
-      const int cu = static_cast<int>(std::floor((u + 0.5f) / cell + offset));
-      const int cv = static_cast<int>(std::floor((v + 0.5f) / cell + offset));
+      const int cu = static_cast<int>(std::floor((u + 0.5f) * inv_cell + offset));
+      const int cv = static_cast<int>(std::floor((v + 0.5f) * inv_cell + offset));
       // Splat the patch over the cells it covers, so that it hides what is behind it.
-      const int radius = std::min(16, static_cast<int>(radius_px / cell + 0.5f));
+      const int radius = std::min(16, static_cast<int>(radius_px * inv_cell + 0.5f));
       for (int y = std::max(0, cv - radius); y <= std::min(padded_height_ - 1, cv + radius); ++y)
         for (int x = std::max(0, cu - radius); x <= std::min(padded_width_ - 1, cu + radius); ++x) {
           float& d = depth_[static_cast<std::size_t>(y) * padded_width_ + x];
