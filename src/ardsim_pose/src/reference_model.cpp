@@ -491,8 +491,6 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
   int u0 = bu, u1 = bu, v0 = bv, v1 = bv;
   scan(u0, u1, v0, v1);
   float reach = 0.0f;
-  const float gate = std::sqrt(max_distance_sq);
-  bool exact = false;  // best is the nearest of all
   for (int w = 0;; ++w) {
     if (w > 0) {
       const int nu0 = std::max(0, bu - w), nu1 = std::min(bins_wide_ - 1, bu + w);
@@ -508,18 +506,8 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
     // sin(a) >= a - a^3 / 6 for a >= 0 (a bound, not a libm call, in the hottest loop).
     const float a = std::min(edge_px * radians_per_px, 1.5707f);
     reach = std::min(range * (a - a * a * a * (1.0f / 6.0f)), 0.999f * (x.z() - kNearestDepthM));
-    exact = exact || best_sq < reach * reach;
-    if (exact) {
-      // The ball as wide as the tree's (the nearest distance and the margin), where the window allows: a
-      // narrower one sends the next iterations' searches back here.
-      if (near == nullptr) break;
-      const float target = best < 0 ? gate : std::min(gate, std::sqrt(best_sq) + margin_m);
-      if (reach >= target) break;
-    }
-    if (w >= kMaxWindowBins) {
-      if (!exact) return false;
-      break;
-    }
+    if (best_sq < reach * reach) break;
+    if (w >= kMaxWindowBins) return false;
   }
   *index = best;
   *distance_sq = best_sq;
