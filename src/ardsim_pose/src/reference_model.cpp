@@ -212,6 +212,17 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
     chunk.radius = 0.5f * chunk_box.diagonal().norm();
     chunks_.push_back(chunk);
   }
+  const Eigen::Index patch_count = static_cast<Eigen::Index>(patches_.size());
+  patch_radii_.resize(patch_count);
+  for (int axis = 0; axis < 3; ++axis) {
+    patch_centres_[axis].resize(patch_count);
+    patch_normals_[axis].resize(patch_count);
+    for (Eigen::Index i = 0; i < patch_count; ++i) {
+      patch_centres_[axis][i] = patches_[static_cast<std::size_t>(i)].centre[axis];
+      patch_normals_[axis][i] = patches_[static_cast<std::size_t>(i)].normal[axis];
+      patch_radii_[i] = patches_[static_cast<std::size_t>(i)].radius;
+    }
+  }
   for (int axis = 0; axis < 3; ++axis) {
     coordinates_[axis].resize(static_cast<Eigen::Index>(points_.size()));
     for (std::size_t i = 0; i < points_.size(); ++i)
@@ -297,16 +308,32 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
     bool outside = false;
     for (const Eigen::Vector3f& plane : planes) outside = outside || plane.dot(c) < -chunk.radius;
     if (outside) continue;
-    for (std::uint32_t i = chunk.begin; i < chunk.end; ++i) {
-      const ReferenceModel::Patch& patch = model.patches()[i];
-      // Back face (seen from behind), tested in target coordinates before the transform: half the patches.
-      if (patch.normal.dot(patch.centre - eye) >= 0.0f) continue;
-      const Eigen::Vector3f p = R * patch.centre + t;
-      if (p.z() < 0.05f) continue;
-      const float inv_z = 1.0f / p.z();
-      const float u = fx * p.x() * inv_z + cx;
-      const float v = fy * p.y() * inv_z + cy;
-      const float radius_px = patch.radius * fx * inv_z;
+    // The chunk's patches as arrays: facing, depth and image position by vectorized expressions (the same
+    // operations in the same order as one patch at a time, so the same floats), then patch by patch.
+    const Eigen::Index begin = chunk.begin, n = chunk.end - chunk.begin;
+    if (facing_.size() < n) {
+      for (Eigen::ArrayXf* a : {&facing_, &depth_z_, &u_, &v_, &radius_px_}) a->resize(n);
+    }
+    const auto CX = model.patchCentres(0).segment(begin, n), CY = model.patchCentres(1).segment(begin, n),
+               CZ = model.patchCentres(2).segment(begin, n);
+    const auto radii = model.patchRadii().segment(begin, n);
+    auto facing = facing_.head(n), z = depth_z_.head(n), us = u_.head(n), vs = v_.head(n),
+         radii_px = radius_px_.head(n);
+    // Back face (seen from behind) when >= 0, in target coordinates: half the patches.
+    facing = model.patchNormals(0).segment(begin, n) * (CX - eye.x()) +
+             model.patchNormals(1).segment(begin, n) * (CY - eye.y()) +
+             model.patchNormals(2).segment(begin, n) * (CZ - eye.z());
+    z = R(2, 0) * CX + R(2, 1) * CY + R(2, 2) * CZ + t.z();
+    // 1 / z where z >= 0.05 (the others are skipped below).
+    radii_px = 1.0f / z.max(0.05f);
+    us = fx * (R(0, 0) * CX + R(0, 1) * CY + R(0, 2) * CZ + t.x()) * radii_px + cx;
+    vs = fy * (R(1, 0) * CX + R(1, 1) * CY + R(1, 2) * CZ + t.y()) * radii_px + cy;
+    radii_px = radii * fx * radii_px;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (facing[k] >= 0.0f || z[k] < 0.05f) continue;
+      const std::uint32_t i = static_cast<std::uint32_t>(begin + k);
+      const float u = us[k], v = vs[k];
+      const float depth = z[k], radius_px = radii_px[k];
       if (u + radius_px < u_min || u - radius_px >= u_max || v + radius_px < v_min || v - radius_px >= v_max)
         continue;
       const int cu = static_cast<int>(std::floor((u + 0.5f) * inv_cell + offset));
@@ -316,11 +343,11 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
       for (int y = std::max(0, cv - radius); y <= std::min(padded_height_ - 1, cv + radius); ++y)
         for (int x = std::max(0, cu - radius); x <= std::min(padded_width_ - 1, cu + radius); ++x) {
           float& d = depth_[static_cast<std::size_t>(y) * padded_width_ + x];
-          d = std::min(d, p.z());
+          d = std::min(d, depth);
         }
       const int cell_index =
           std::clamp(cv, 0, padded_height_ - 1) * padded_width_ + std::clamp(cu, 0, padded_width_ - 1);
-      if (visible != nullptr) candidates_.push_back({i, cell_index, p.z() - patch.radius});
+      if (visible != nullptr) candidates_.push_back({i, cell_index, depth - radii[k]});
     }
   }
   int count = 0;

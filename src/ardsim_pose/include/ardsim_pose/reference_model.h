@@ -87,6 +87,10 @@ class ReferenceModel {
     std::uint32_t end = 0;
   };
   const std::vector<Patch>& patches() const { return patches_; }
+  // The patches' centres, normals (axis 0-2) and radii as arrays (vectorized per chunk).
+  const Eigen::ArrayXf& patchCentres(int axis) const { return patch_centres_[axis]; }
+  const Eigen::ArrayXf& patchNormals(int axis) const { return patch_normals_[axis]; }
+  const Eigen::ArrayXf& patchRadii() const { return patch_radii_; }
   const std::vector<Chunk>& chunks() const { return chunks_; }
 
  private:
@@ -95,6 +99,9 @@ class ReferenceModel {
   std::vector<Eigen::Vector3f> normals_;
   std::vector<float> spacing_;
   std::array<Eigen::ArrayXf, 3> coordinates_;
+  std::array<Eigen::ArrayXf, 3> patch_centres_;
+  std::array<Eigen::ArrayXf, 3> patch_normals_;
+  Eigen::ArrayXf patch_radii_;
   std::vector<Patch> patches_;
   std::vector<Chunk> chunks_;
   std::unique_ptr<KdTree> tree_;
@@ -149,6 +156,7 @@ class VisibilityPredictor {
   };
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> visible_patches_;
+  Eigen::ArrayXf facing_, depth_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
 };
 
 // The visible model points binned by the pixels they project to at one pose: an exact nearest-visible-point
