@@ -312,23 +312,23 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
     // operations in the same order as one patch at a time, so the same floats), then patch by patch.
     const Eigen::Index begin = chunk.begin, n = chunk.end - chunk.begin;
     if (facing_.size() < n) {
-      for (Eigen::ArrayXf* a : {&facing_, &depth_z_, &u_, &v_, &radius_px_}) a->resize(n);
+      for (Eigen::ArrayXf* a : {&facing_, &depth_z_, &inv_z_, &u_, &v_, &radius_px_}) a->resize(n);
     }
     const auto CX = model.patchCentres(0).segment(begin, n), CY = model.patchCentres(1).segment(begin, n),
                CZ = model.patchCentres(2).segment(begin, n);
     const auto radii = model.patchRadii().segment(begin, n);
-    auto facing = facing_.head(n), z = depth_z_.head(n), us = u_.head(n), vs = v_.head(n),
-         radii_px = radius_px_.head(n);
+    auto facing = facing_.head(n), z = depth_z_.head(n), inv_z = inv_z_.head(n), us = u_.head(n),
+         vs = v_.head(n), radii_px = radius_px_.head(n);
     // Back face (seen from behind) when >= 0, in target coordinates: half the patches.
     facing = model.patchNormals(0).segment(begin, n) * (CX - eye.x()) +
              model.patchNormals(1).segment(begin, n) * (CY - eye.y()) +
              model.patchNormals(2).segment(begin, n) * (CZ - eye.z());
     z = R(2, 0) * CX + R(2, 1) * CY + R(2, 2) * CZ + t.z();
     // 1 / z where z >= 0.05 (the others are skipped below).
-    radii_px = 1.0f / z.max(0.05f);
-    us = fx * (R(0, 0) * CX + R(0, 1) * CY + R(0, 2) * CZ + t.x()) * radii_px + cx;
-    vs = fy * (R(1, 0) * CX + R(1, 1) * CY + R(1, 2) * CZ + t.y()) * radii_px + cy;
-    radii_px = radii * fx * radii_px;
+    inv_z = 1.0f / z.max(0.05f);
+    us = fx * (R(0, 0) * CX + R(0, 1) * CY + R(0, 2) * CZ + t.x()) * inv_z + cx;
+    vs = fy * (R(1, 0) * CX + R(1, 1) * CY + R(1, 2) * CZ + t.y()) * inv_z + cy;
+    radii_px = radii * fx * inv_z;
     for (Eigen::Index k = 0; k < n; ++k) {
       if (facing[k] >= 0.0f || z[k] < 0.05f) continue;
       const std::uint32_t i = static_cast<std::uint32_t>(begin + k);

@@ -122,7 +122,8 @@ class VisibilityPredictor {
   VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options);
 
   // Fills visible (one flag per model point) and the per-cell depth of the nearest predicted surface.
-  // Returns the number of visible points. visible nullptr: the depths alone (a third faster), returns 0.
+  // Returns the number of visible points. visible nullptr: the depths alone (no visibility test per patch),
+  // returns 0.
   int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
               std::vector<std::uint8_t>* visible);
 
@@ -156,7 +157,7 @@ class VisibilityPredictor {
   };
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> visible_patches_;
-  Eigen::ArrayXf facing_, depth_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
+  Eigen::ArrayXf facing_, depth_z_, inv_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
 };
 
 // The visible model points binned by the pixels they project to at one pose: an exact nearest-visible-point
@@ -189,10 +190,10 @@ class VisiblePointGrid {
   float min_cos_sq_ = 1.0f;  // squared cosine of the off-axis angle of the padded image's corner
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   Eigen::Vector3f t_ = Eigen::Vector3f::Zero();
-  std::vector<std::uint32_t> bin_begin_;                        // bins_wide_ x bins_high_ + 1
-  std::vector<Eigen::Vector3f> bin_points_;                     // target frame, bin by bin
-  std::vector<std::uint32_t> bin_index_;                        // their model point indices
-  std::vector<std::int32_t> bin_of_;                            // scratch: bin per point of the patches
+  std::vector<std::uint32_t> bin_begin_;     // (bins_wide_ + 2) x (bins_high_ + 2) + 1: a border of one bin
+  std::vector<Eigen::Vector3f> bin_points_;  // target frame, bin by bin
+  std::vector<std::uint32_t> bin_index_;     // their model point indices
+  std::vector<std::int32_t> bin_of_;         // scratch: bin per point of the patches
   std::vector<std::pair<std::uint32_t, std::uint32_t>> runs_;   // scratch: the patches' point ranges
   Eigen::ArrayXf x_, y_, z_;                                    // scratch
   mutable std::vector<std::pair<float, std::uint32_t>> found_;  // scratch of nearest()
