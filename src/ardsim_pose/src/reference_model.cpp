@@ -185,6 +185,8 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
   points_.reserve(points.size());
   normals_.reserve(points.size());
   spacing_.reserve(points.size());
+  std::vector<Eigen::Vector3f> patch_centres, patch_normals;
+  std::vector<float> patch_radii;
   for (const auto& chunk_entry : chunk_members) {
     Chunk chunk;
     chunk.begin = static_cast<std::uint32_t>(patches_.size());
@@ -192,7 +194,7 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
     for (const std::vector<std::uint32_t>* members : chunk_entry.second) {
       Patch patch;
       patch.begin = static_cast<std::uint32_t>(points_.size());
-      patch.normal = normals[members->front()];
+      patch_normals.push_back(normals[members->front()]);
       Eigen::AlignedBox3f box;
       for (std::uint32_t i : *members) {
         points_.push_back(points[i]);
@@ -201,9 +203,9 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
         box.extend(points[i]);
       }
       patch.end = static_cast<std::uint32_t>(points_.size());
-      patch.centre = box.center();
+      patch_centres.push_back(box.center());
       // Half a spacing beyond the outermost samples: the surface the samples stand for.
-      patch.radius = 0.5f * box.diagonal().norm() + 0.5f * spacing[members->front()];
+      patch_radii.push_back(0.5f * box.diagonal().norm() + 0.5f * spacing[members->front()]);
       patches_.push_back(patch);
       chunk_box.extend(box);
     }
@@ -212,18 +214,17 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
     chunk.radius = 0.5f * chunk_box.diagonal().norm();
     chunks_.push_back(chunk);
   }
-  const Eigen::Index patch_count = static_cast<Eigen::Index>(patches_.size());
-  patch_radii_.resize(patch_count);
+  // Arrays for vectorized loops over ranges of patches and points (the points also stay as vectors: the tree
+  // and the ICP read them one at a time).
+  patch_radii_ =
+      Eigen::Map<const Eigen::ArrayXf>(patch_radii.data(), static_cast<Eigen::Index>(patch_radii.size()));
   for (int axis = 0; axis < 3; ++axis) {
-    patch_centres_[axis].resize(patch_count);
-    patch_normals_[axis].resize(patch_count);
-    for (Eigen::Index i = 0; i < patch_count; ++i) {
-      patch_centres_[axis][i] = patches_[static_cast<std::size_t>(i)].centre[axis];
-      patch_normals_[axis][i] = patches_[static_cast<std::size_t>(i)].normal[axis];
-      patch_radii_[i] = patches_[static_cast<std::size_t>(i)].radius;
+    patch_centres_[axis].resize(static_cast<Eigen::Index>(patch_centres.size()));
+    patch_normals_[axis].resize(static_cast<Eigen::Index>(patch_normals.size()));
+    for (std::size_t i = 0; i < patch_centres.size(); ++i) {
+      patch_centres_[axis][static_cast<Eigen::Index>(i)] = patch_centres[i][axis];
+      patch_normals_[axis][static_cast<Eigen::Index>(i)] = patch_normals[i][axis];
     }
-  }
-  for (int axis = 0; axis < 3; ++axis) {
     coordinates_[axis].resize(static_cast<Eigen::Index>(points_.size()));
     for (std::size_t i = 0; i < points_.size(); ++i)
       coordinates_[axis][static_cast<Eigen::Index>(i)] = points_[i][axis];

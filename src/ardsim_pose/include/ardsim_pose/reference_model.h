@@ -72,10 +72,7 @@ class ReferenceModel {
   bool anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const;
 
   // Samples of one triangle close together: one visibility decision for all (points [begin, end)).
-  struct Patch {
-    Eigen::Vector3f centre;
-    Eigen::Vector3f normal;
-    float radius = 0.0f;
+  struct Patch {  // its centre, normal and bounding radius: patchCentres, patchNormals, patchRadii
     std::uint32_t begin = 0;
     std::uint32_t end = 0;
   };
