@@ -488,8 +488,7 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
   // no window reaches: they too lie outside it.
   const float range = 0.999f * x.norm();
   const float radians_per_px = min_cos_sq_ / static_cast<float>(std::max(intrinsics_.fx, intrinsics_.fy));
-  std::vector<std::pair<float, std::uint32_t>>& found = found_;  // window points that may be in the ball
-  found.clear();
+  found_.clear();  // window points that may be in the ball
   float best_sq = max_distance_sq;
   int best = -1;
   float ball_limit_sq = max_distance_sq;  // the ball cannot reach past the nearest distance and the margin
@@ -497,14 +496,9 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
     for (int y = va; y <= vb; ++y) {
       const std::size_t row = static_cast<std::size_t>(y + 1) * (bins_wide_ + 2) + 1;  // past the border
       for (std::uint32_t k = bin_begin_[row + ua]; k < bin_begin_[row + ub + 1]; ++k) {
-        const Eigen::Vector3f& p = bin_points_[k];
-        float d = 0.0f;  // as the tree sums it
-        for (int c = 0; c < 3; ++c) {
-          const float diff = query[c] - p[c];
-          d += diff * diff;
-        }
+        const float d = treeDistanceSq(query, bin_points_[k]);
         if (!(d < ball_limit_sq)) continue;
-        if (near != nullptr) found.push_back({d, bin_index_[k]});
+        if (near != nullptr) found_.push_back({d, bin_index_[k]});
         if (d < best_sq) {
           best_sq = d;
           best = static_cast<int>(bin_index_[k]);
@@ -543,7 +537,7 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
   float ball = best < 0 ? std::sqrt(max_distance_sq) : std::sqrt(best_sq) + margin_m;
   ball = std::min({ball, std::sqrt(max_distance_sq), reach});
   const float ball_sq = ball * ball;
-  for (const auto& [d, i] : found)
+  for (const auto& [d, i] : found_)
     if (d < ball_sq) near->push_back(i);
   *radius_m = ball;
   return true;

@@ -18,6 +18,17 @@
 
 namespace ardsim_pose {
 
+// Squared distance summed x, y, z in that order, as nanoflann's L2_Simple_Adaptor sums it: every search that
+// stands in for the tree (the balls, the visible-point grid) finds the same nearest point and distance.
+inline float treeDistanceSq(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  float sum = 0.0f;
+  for (int d = 0; d < 3; ++d) {
+    const float diff = a[d] - b[d];
+    sum += diff * diff;
+  }
+  return sum;
+}
+
 struct ReferenceModelOptions {
   // Sample spacing on the surfaces grows with the distance from the docking port: the port is seen from
   // metres, the far structure only from tens of metres, where a pixel is as wide as the coarser spacing.
@@ -61,12 +72,7 @@ class ReferenceModel {
                                    std::vector<std::uint32_t>* near) const;
   // Squared distance from query to point index, computed as the tree computes it.
   float distanceSq(const Eigen::Vector3f& query, std::uint32_t index) const {
-    float sum = 0.0f;
-    for (int d = 0; d < 3; ++d) {
-      const float diff = query[d] - points_[index][d];
-      sum += diff * diff;
-    }
-    return sum;
+    return treeDistanceSq(query, points_[index]);
   }
   // Whether any model point, visible or not, lies within sqrt(max_distance_sq) of query (target frame).
   bool anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const;
