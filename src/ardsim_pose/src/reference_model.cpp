@@ -101,6 +101,19 @@ struct NearestVisibleResult {
   bool full() const { return best_index >= 0; }
 };
 
+// Whether any point lies within a distance: the search prunes beyond it and stops at the first found (the
+// nearest point, searched in full, cost a tenth of a tracking frame at 10 m).
+struct AnyWithinResult {
+  float reach_sq;  // just above the distance squared: the tree passes only points strictly nearer
+  bool found = false;
+  bool addPoint(float, std::uint32_t) {
+    found = true;
+    return false;
+  }
+  float worstDist() const { return reach_sq; }
+  bool full() const { return found; }
+};
+
 // The nearest visible point, collecting on the way every visible point within margin of it: the search
 // reach is the nearest distance found so far plus the margin (the gate until one is found).
 struct NeighbourhoodResult {
@@ -259,12 +272,9 @@ int ReferenceModel::nearestVisibleWithNeighbours(const Eigen::Vector3f& query, f
 }
 
 bool ReferenceModel::anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const {
-  std::uint32_t index = 0;
-  float distance_sq = 0.0f;
-  nanoflann::KNNResultSet<float, std::uint32_t> result(1);
-  result.init(&index, &distance_sq);
+  AnyWithinResult result{std::nextafter(max_distance_sq, std::numeric_limits<float>::infinity())};
   tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
-  return distance_sq <= max_distance_sq;
+  return result.found;
 }
 
 VisibilityPredictor::VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics,
