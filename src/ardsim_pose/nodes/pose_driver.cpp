@@ -75,6 +75,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/degraded_weak_slide_px", &i.degraded_weak_slide_px);
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/boresight_prior_deg", &i.boresight_prior_deg);
+  read(nh, "icp/crop_reuse_px", &i.crop_reuse_px);
   read(nh, "icp/converged_translation_m", &i.converged_translation_m);
   read(nh, "icp/converged_rotation_rad", &i.converged_rotation_rad);
   read(nh, "icp/revisibility_translation_m", &i.revisibility_translation_m);

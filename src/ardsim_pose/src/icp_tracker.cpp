@@ -34,9 +34,7 @@ constexpr float kNeighbourhoodMarginM = 0.03f;
 // approach dataset 60 left no range band slower than the tree alone (100: acquisition frames 5-10 % slower).
 constexpr int kGridBuildRatio = 60;
 // The coverage and silhouette checks of a final pose take a visibility prediction made at a pose that moves
-// every visible model point less than one of its 4 px cells in the image (they allow a cell or more). (The
-// gate and the crop at the start of an alignment take only one made at exactly their pose: with this
-// tolerance there too, the ISS approach dataset's attitude inside 10 m went from 0.043 to 0.108 deg RMS.)
+// every visible model point less than one of its 4 px cells in the image (they allow a cell or more).
 constexpr double kVisibilityTolerancePx = 4.0;
 
 void require(bool ok, const std::string& name, double value, const std::string& allowed) {
@@ -96,6 +94,8 @@ void validate(const IcpOptions& o) {
   require(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
       "icp/boresight_prior_deg", o.boresight_prior_deg, "0 .. 180");
+  require(std::isfinite(o.crop_reuse_px) && o.crop_reuse_px >= 0.0 && o.crop_reuse_px <= 4.0,
+          "icp/crop_reuse_px", o.crop_reuse_px, "0 .. 4");
   require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
           "> 0");
   require(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad, "> 0");
@@ -398,10 +398,10 @@ double IcpTracker::silhouetteInlierFraction(double limit_m) {
   return on > 0 ? static_cast<double>(inliers) / on : 0.0;
 }
 
-void IcpTracker::gateToSilhouette(const Eigen::Isometry3d& T, double margin_px) {
+void IcpTracker::gateToSilhouette(const Eigen::Isometry3d& T, double margin_px, double tolerance_px) {
   gated_ = valid_;
   if (!(margin_px > 0.0)) return;
-  predictVisibility(T);
+  predictVisibility(T, tolerance_px);
   const int r = static_cast<int>(std::ceil(margin_px / visibility().cellPx()));
   if (r >= std::max(visibility().gridWidth(), visibility().gridHeight())) return;
   markSilhouette(r);
@@ -472,7 +472,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
                 static_cast<int>(scan_.size()) >= 2 * kCoarseStride * options_.min_points;
   selectActive(coarse ? kCoarseStride : stride);
   Eigen::Isometry3d& T = a.T;
-  predictVisibility(T);  // tracking: the gate's
+  predictVisibility(T, tracking ? crop_tolerance_px_ : 0.0);  // tracking: the gate's
   Eigen::Isometry3d T_visibility = T;
   for (; a.iterations < max_iterations && !a.converged; ++a.iterations) {
     const Eigen::Isometry3d moved = T_visibility.inverse() * T;
@@ -779,7 +779,10 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     const double range_m = std::max(1.0, T_predicted.translation().norm());
     margin_px += (options_.search_lateral_m + options_.search_offset_m) / range_m * intrinsics_.fx;
   }
-  gateToSilhouette(T_predicted, margin_px);
+  // Tracking: a visibility prediction (and its grid) made at a pose near enough serves this frame's gate and
+  // crop too (IcpOptions::crop_reuse_px).
+  crop_tolerance_px_ = acquiring ? 0.0 : options_.crop_reuse_px;
+  gateToSilhouette(T_predicted, margin_px, crop_tolerance_px_);
   const std::size_t count = std::min<std::size_t>(gated_.size(), options_.max_points);
   scan_.reserve(count);
   for (std::size_t k = 0; k < count; ++k) scan_.push_back(cloud.points[gated_[k * gated_.size() / count]]);

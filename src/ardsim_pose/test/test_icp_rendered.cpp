@@ -106,6 +106,38 @@ INSTANTIATE_TEST_SUITE_P(Ranges, Acquisition,
                                            Case{29.0, false, 0.02, 0.05}, Case{29.0, true, 0.02, 0.05},
                                            Case{9.0, false, 0.02, 0.05}, Case{9.0, true, 0.02, 0.05}));
 
+// Tracking frames take a visibility prediction made within icp/crop_reuse_px (2) of their prediction: at 59
+// m, closing 1 cm a frame, one serves several frames. The estimates stay those of exact predictions, within
+// the noise (a crop a pixel off changes a few edge points) and the goals.
+TEST_F(RenderedIcp, ReusedVisibilityPredictionsKeepTheEstimates) {
+  ardsim_lidar::LidarSimulator simulator(ardsim_lidar::SensorOptions{}, ardsim_lidar::NoiseOptions{}, 7);
+  simulator.setTarget(ardsim_description::buildIss());
+  PoseConfig exact;
+  exact.icp.crop_reuse_px = 0.0;
+  std::unique_ptr<PoseEstimator> reusing = makeEstimator(PoseConfig{}, iss_model_);
+  std::unique_ptr<PoseEstimator> predicting = makeEstimator(exact, iss_model_);
+  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kIss);
+  reusing->setPrior(dockingAxisPose(TargetKind::kIss, 59.0));
+  predicting->setPrior(dockingAxisPose(TargetKind::kIss, 59.0));
+  ardsim_lidar::LidarFrame frame;
+  for (int k = 0; k < 30; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kIss, 59.0 - 0.01 * k);
+    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
+    const OrganizedCloud cloud = fromLidarFrame(frame, simulator.rays(), 0.1 * k);
+    const PoseResult a = reusing->process(cloud).result;
+    const PoseResult b = predicting->process(cloud).result;
+    ASSERT_EQ(a.status, EstimateStatus::kTracking) << a.reason;
+    ASSERT_EQ(b.status, EstimateStatus::kTracking) << b.reason;
+    const PoseErrorValue difference = poseError(a.T_lidar_target, b.T_lidar_target, T_target_port);
+    EXPECT_LT(difference.port_position_error_m.norm(), 0.005);
+    EXPECT_LT(difference.attitude_error_angle_rad * 180.0 / M_PI, 0.02);
+    const PoseErrorValue error = poseError(a.T_lidar_target, truth, T_target_port);
+    EXPECT_LT(error.port_position_error_m.norm(), 0.05);
+    EXPECT_LT(error.attitude_error_angle_rad * 180.0 / M_PI, 0.1);
+  }
+}
+
 // At 249 m the arrays and radiators (not in the rigid model) fill most of the view: before the scan was gated
 // to the model's silhouette, every frame there was LOST (inlier fraction 0.15).
 TEST_F(RenderedIcp, SolarArraysTurnedFromTheModelDoNotMatter) {
