@@ -50,10 +50,10 @@ struct IcpOptions {
   // made at a pose that moves every visible model point less than this many pixels from where the frame's
   // prediction puts it (a fraction of the prediction's 4 px cells), e.g. the frame before's: in the closed
   // loop a prediction moves a fraction of a pixel a frame from 100 m to ~20 m out, so one serves a few
-  // frames. ISS approach 99 -> 79 m in 2 cm steps (1001 frames): 2.17 -> 1.03 ms a frame, the errors
-  // unchanged (position RMS 2.2 mm, max 5.5; attitude RMS 0.0100 deg, max 0.0246). 0: one made at exactly the
-  // prediction (Hubble's default: its roll, held at the prediction end-on, follows the few pixels such a crop
-  // changes: a 50 -> 20 m approach in 3 cm steps went from 0.26 to 0.29-0.88 deg roll RMS).
+  // frames. ISS approach 99 -> 79 m in 2 cm steps (1001 frames): 1.72 -> 0.62 ms a frame (interleaved), the
+  // errors unchanged (position RMS 2.2 mm, max 5.5; attitude RMS 0.0100 deg, max 0.0246). 0: one made at
+  // exactly the prediction (Hubble's default: its roll, held at the prediction end-on, follows the few pixels
+  // such a crop changes: a 50 -> 20 m approach in 3 cm steps went from 0.26 to 0.29-0.88 deg roll RMS).
   double crop_reuse_px = 2.0;
   double converged_translation_m = 1e-4;  // an update smaller than both ends the iterations
   double converged_rotation_rad = 1e-5;
