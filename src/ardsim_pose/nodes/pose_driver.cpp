@@ -64,6 +64,8 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "visibility/depth_tolerance_m", &c.visibility.depth_tolerance_m);
   IcpOptions& i = c.icp;
   read(nh, "icp/max_points", &i.max_points);
+  read(nh, "icp/max_points_near", &i.max_points_near);
+  read(nh, "icp/near_depth_m", &i.near_depth_m);
   read(nh, "icp/silhouette_margin_px", &i.silhouette_margin_px);
   read(nh, "icp/max_iterations_tracking", &i.max_iterations_tracking);
   read(nh, "icp/max_iterations_acquisition", &i.max_iterations_acquisition);

@@ -33,6 +33,7 @@ void applyTargetDefaults(PoseConfig* config) {
   // runs, worst 1.46 deg RMS); with 5000 (every gated pixel out to ~40 m) in 21 of 26, worst 0.94 deg, at
   // ~11-13 ms a frame instead of 7-9.
   config->icp.max_points = hubble ? 5000 : defaults.icp.max_points;
+  config->icp.max_points_near = hubble ? 5000 : defaults.icp.max_points_near;
   // Its roll, held at the prediction end-on, follows the few pixels a reused visibility prediction changes.
   config->icp.crop_reuse_px = hubble ? 0.0 : defaults.icp.crop_reuse_px;
   // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43

@@ -77,6 +77,10 @@ std::string format(const char* pattern, double a, double b = 0.0) {
 
 void validate(const IcpOptions& o) {
   require(o.max_points >= 50 && o.max_points <= 100000, "icp/max_points", o.max_points, "50 .. 100000");
+  require(o.max_points_near >= 50 && o.max_points_near <= 100000, "icp/max_points_near", o.max_points_near,
+          "50 .. 100000");
+  require(std::isfinite(o.near_depth_m) && o.near_depth_m >= 0.0 && o.near_depth_m <= 1000.0,
+          "icp/near_depth_m", o.near_depth_m, "0 .. 1000");
   require(o.max_iterations_tracking >= 1 && o.max_iterations_tracking <= 200, "icp/max_iterations_tracking",
           o.max_iterations_tracking, "1 .. 200");
   require(o.max_iterations_acquisition >= 1 && o.max_iterations_acquisition <= 500,
@@ -106,8 +110,8 @@ void validate(const IcpOptions& o) {
   require(std::isfinite(o.silhouette_margin_px) && o.silhouette_margin_px >= 0.0 &&
               o.silhouette_margin_px <= 256.0,
           "icp/silhouette_margin_px", o.silhouette_margin_px, "0 .. 256");
-  require(o.min_points >= 6 && o.min_points <= o.max_points, "icp/min_points", o.min_points,
-          "6 .. max_points");
+  require(o.min_points >= 6 && o.min_points <= std::min(o.max_points, o.max_points_near), "icp/min_points",
+          o.min_points, "6 .. max_points and max_points_near");
   require(fraction(o.lost_inlier_fraction), "icp/lost_inlier_fraction", o.lost_inlier_fraction, "0 .. 1");
   require(fraction(o.degraded_inlier_fraction) && o.degraded_inlier_fraction >= o.lost_inlier_fraction,
           "icp/degraded_inlier_fraction", o.degraded_inlier_fraction, "lost_inlier_fraction .. 1");
@@ -783,7 +787,10 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   // crop too (IcpOptions::crop_reuse_px).
   crop_tolerance_px_ = acquiring ? 0.0 : options_.crop_reuse_px;
   gateToSilhouette(T_predicted, margin_px, crop_tolerance_px_);
-  const std::size_t count = std::min<std::size_t>(gated_.size(), options_.max_points);
+  // The gate's visibility prediction (or, with no gate, the last one) says how near the model is.
+  const bool near = slots_[current_].valid && visibility().nearestDepth() < options_.near_depth_m;
+  const std::size_t count =
+      std::min<std::size_t>(gated_.size(), near ? options_.max_points_near : options_.max_points);
   scan_.reserve(count);
   for (std::size_t k = 0; k < count; ++k) scan_.push_back(cloud.points[gated_[k * gated_.size() / count]]);
 

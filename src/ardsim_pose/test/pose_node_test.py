@@ -119,6 +119,7 @@ class PoseInterfaceTest(unittest.TestCase):
         # One node name per case: a _param:= setting stays on the parameter server after its node exits.
         cases = [('_icp/max_points:=3', 'icp/max_points = 3'),
                  ('_icp/crop_reuse_px:=9.0', 'icp/crop_reuse_px = 9'),
+                 ('_icp/near_depth_m:=-1.0', 'icp/near_depth_m = -1'),
                  ('_mode/close_method:=laser', "mode/close_method = 'laser'"),
                  ('_mode/close_exit_range_m:=5.0', 'mode/close_exit_range_m = 5'),
                  ('_estimator/composite_max_port_range_m:=-5.0', 'estimator/composite_max_port_range_m = -5')]
