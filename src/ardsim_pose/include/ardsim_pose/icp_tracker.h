@@ -20,10 +20,10 @@ namespace ardsim_pose {
 
 struct IcpOptions {
   int max_points = 1000;  // scan points per frame (evenly spread over the gated valid pixels)
-  // Where the model's nearest predicted surface is nearer than near_depth_m (0: never), max_points_near
-  // instead: there the ISS's docking adapter fills the view and its roll rests on a few asymmetric features
-  // (a 16 -> 6 m approach in 2 cm steps, ICP alone from the truth: 6-10 m attitude RMS 0.051 -> 0.038 deg,
-  // worst frame 0.186 -> 0.116 deg with 2500 instead of 1000; 1.5 -> 2.8 ms a frame).
+  // Tracking (not acquiring), where the model's nearest predicted surface is nearer than near_depth_m (0:
+  // never), max_points_near instead: there the ISS's docking adapter fills the view and its roll rests on a
+  // few asymmetric features (a 16 -> 6 m approach in 2 cm steps, ICP alone from the truth: 6-10 m attitude
+  // RMS 0.051 -> 0.038 deg, worst frame 0.186 -> 0.116 deg with 2500 instead of 1000; 1.5 -> 2.8 ms a frame).
   int max_points_near = 2500;
   double near_depth_m = 12.0;
   // Scan points come only from pixels within this of the model's silhouette at the predicted pose (while
