@@ -476,7 +476,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
                 static_cast<int>(scan_.size()) >= 2 * kCoarseStride * options_.min_points;
   selectActive(coarse ? kCoarseStride : stride);
   Eigen::Isometry3d& T = a.T;
-  predictVisibility(T, tracking ? crop_tolerance_px_ : 0.0);  // tracking: the gate's
+  predictVisibility(T, tracking ? options_.crop_reuse_px : 0.0);  // tracking: the gate's
   Eigen::Isometry3d T_visibility = T;
   for (; a.iterations < max_iterations && !a.converged; ++a.iterations) {
     const Eigen::Isometry3d moved = T_visibility.inverse() * T;
@@ -785,8 +785,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   }
   // Tracking: a visibility prediction (and its grid) made at a pose near enough serves this frame's gate and
   // crop too (IcpOptions::crop_reuse_px).
-  crop_tolerance_px_ = acquiring ? 0.0 : options_.crop_reuse_px;
-  gateToSilhouette(T_predicted, margin_px, crop_tolerance_px_);
+  gateToSilhouette(T_predicted, margin_px, acquiring ? 0.0 : options_.crop_reuse_px);
   // The gate's visibility prediction (or, with no gate, the last one) says how near the model is. Tracking
   // only: the acquisition search, ~25 alignments, would cost twice as much (9 m frames from the coarse
   // prior).

@@ -102,7 +102,7 @@ struct NearestVisibleResult {
 };
 
 // Whether any point lies within a distance: the search prunes beyond it and stops at the first found (the
-// nearest point, searched in full, cost a tenth of a tracking frame at 10 m).
+// nearest point, searched in full, cost 5-7 % of a tracking frame at 10 m).
 struct AnyWithinResult {
   float reach_sq;  // just above the distance squared: the tree passes only points strictly nearer
   bool found = false;

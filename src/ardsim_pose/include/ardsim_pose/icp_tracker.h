@@ -213,7 +213,6 @@ class IcpTracker : public PoseMethod {
   std::array<VisibilitySlot, 2> slots_;
   int current_ = 0;
   bool acquiring_ = true;
-  double crop_tolerance_px_ = 0.0;  // of this frame's first visibility prediction (crop_reuse_px or 0)
   std::vector<std::pair<double, Eigen::Isometry3d>>
       acquired_;  // (stamp s, pose) of the last acquisition frames
   double coverage_ = 0.0;
