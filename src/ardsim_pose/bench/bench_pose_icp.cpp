@@ -11,8 +11,18 @@
 // (the crop changes every frame) and the alignment; for ours: the whole estimate() from the organized cloud
 // (subsampling, visibility crop, ICP, quality checks, covariance). Counters: mean port position error (m) and
 // attitude error (deg) against the truth over the frames.
+//
+// PCL twice: as shipped, and with OpenMP regions of one thread run inline (`..InlineOmp`). Debian's FLANN,
+// under PCL's KdTreeFLANN, opens a parallel region of one thread (SearchParams::cores) for every query, and
+// libgomp ends each with a futex wake syscall although nothing waits; where a syscall is dear (a virtual
+// machine) that is most of PCL's time (2026-11-23, this 2-core guest: 120 vs 17 ms a 10 m frame), and how
+// dear depends on the host. The inline variant does the same arithmetic (identical transforms) without it:
+// the ratio to it compares the work alone, on any host.
 #include <benchmark/benchmark.h>
+#include <dlfcn.h>
 #include <omp.h>
+
+#include <atomic>
 
 #include <map>
 #include <memory>
@@ -28,6 +38,22 @@
 #include "ardsim_pose/estimator_factory.h"
 #include "ardsim_pose/evaluation.h"
 #include "open3d_peer.h"
+
+namespace {
+std::atomic<bool> g_inline_one_thread_regions{false};
+}  // namespace
+
+// Interposes libgomp's entry to a parallel region (the executable's definition wins, exported by the link
+// option in CMakeLists.txt); everything but one-thread regions while g_inline_one_thread_regions goes to it.
+extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned num_threads, unsigned flags) {
+  using Entry = void (*)(void (*)(void*), void*, unsigned, unsigned);
+  static const Entry libgomp_parallel = reinterpret_cast<Entry>(dlsym(RTLD_NEXT, "GOMP_parallel"));
+  if (num_threads == 1 && g_inline_one_thread_regions.load(std::memory_order_relaxed)) {
+    fn(data);  // outside a team, omp_get_num_threads() is 1 and worksharing loops give this thread all
+    return;
+  }
+  libgomp_parallel(fn, data, num_threads, flags);
+}
 
 namespace ardsim_pose {
 namespace {
@@ -162,7 +188,17 @@ void BM_IcpTrack_Ardsim(benchmark::State& state) {
   state.counters["iterations"] = iterations / std::max<double>(1.0, static_cast<double>(k));
 }
 
-void BM_IcpTrack_PclIcp(benchmark::State& state) {
+// Sets g_inline_one_thread_regions for one benchmark's lifetime.
+class InlineOneThreadRegions {
+ public:
+  explicit InlineOneThreadRegions(bool on) { g_inline_one_thread_regions = on; }
+  ~InlineOneThreadRegions() { g_inline_one_thread_regions = false; }
+  InlineOneThreadRegions(const InlineOneThreadRegions&) = delete;
+  InlineOneThreadRegions& operator=(const InlineOneThreadRegions&) = delete;
+};
+
+void pclIcp(benchmark::State& state, bool inline_one_thread_regions) {
+  const InlineOneThreadRegions regions(inline_one_thread_regions);
   const std::vector<Frame>& frames = fixture().frames.at(static_cast<int>(state.range(0)));
   ErrorCounters errors;
   pcl::PointCloud<pcl::PointXYZ> aligned;
@@ -181,7 +217,8 @@ void BM_IcpTrack_PclIcp(benchmark::State& state) {
   errors.report(state, frames);
 }
 
-void BM_IcpTrack_PclIcpNormals(benchmark::State& state) {
+void pclIcpNormals(benchmark::State& state, bool inline_one_thread_regions) {
+  const InlineOneThreadRegions regions(inline_one_thread_regions);
   const std::vector<Frame>& frames = fixture().frames.at(static_cast<int>(state.range(0)));
   ErrorCounters errors;
   pcl::PointCloud<pcl::PointNormal> aligned;
@@ -199,6 +236,11 @@ void BM_IcpTrack_PclIcpNormals(benchmark::State& state) {
   }
   errors.report(state, frames);
 }
+
+void BM_IcpTrack_PclIcp(benchmark::State& state) { pclIcp(state, false); }
+void BM_IcpTrack_PclIcpInlineOmp(benchmark::State& state) { pclIcp(state, true); }
+void BM_IcpTrack_PclIcpNormals(benchmark::State& state) { pclIcpNormals(state, false); }
+void BM_IcpTrack_PclIcpNormalsInlineOmp(benchmark::State& state) { pclIcpNormals(state, true); }
 
 void BM_IcpTrack_Open3d(benchmark::State& state) {
   const std::vector<Frame>& frames = fixture().frames.at(static_cast<int>(state.range(0)));
@@ -218,7 +260,9 @@ void BM_IcpTrack_Open3d(benchmark::State& state) {
 
 BENCHMARK(BM_IcpTrack_Ardsim)->Arg(100)->Arg(30)->Arg(10)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_IcpTrack_PclIcp)->Arg(100)->Arg(30)->Arg(10)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_IcpTrack_PclIcpInlineOmp)->Arg(100)->Arg(30)->Arg(10)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_IcpTrack_PclIcpNormals)->Arg(100)->Arg(30)->Arg(10)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_IcpTrack_PclIcpNormalsInlineOmp)->Arg(100)->Arg(30)->Arg(10)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_IcpTrack_Open3d)->Arg(100)->Arg(30)->Arg(10)->Unit(benchmark::kMillisecond);
 
 }  // namespace
