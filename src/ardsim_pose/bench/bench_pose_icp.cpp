@@ -237,10 +237,18 @@ void pclIcpNormals(benchmark::State& state, bool inline_one_thread_regions) {
   errors.report(state, frames);
 }
 
-void BM_IcpTrack_PclIcp(benchmark::State& state) { pclIcp(state, false); }
-void BM_IcpTrack_PclIcpInlineOmp(benchmark::State& state) { pclIcp(state, true); }
-void BM_IcpTrack_PclIcpNormals(benchmark::State& state) { pclIcpNormals(state, false); }
-void BM_IcpTrack_PclIcpNormalsInlineOmp(benchmark::State& state) { pclIcpNormals(state, true); }
+void BM_IcpTrack_PclIcp(benchmark::State& state) {
+  pclIcp(state, false);
+}
+void BM_IcpTrack_PclIcpInlineOmp(benchmark::State& state) {
+  pclIcp(state, true);
+}
+void BM_IcpTrack_PclIcpNormals(benchmark::State& state) {
+  pclIcpNormals(state, false);
+}
+void BM_IcpTrack_PclIcpNormalsInlineOmp(benchmark::State& state) {
+  pclIcpNormals(state, true);
+}
 
 void BM_IcpTrack_Open3d(benchmark::State& state) {
   const std::vector<Frame>& frames = fixture().frames.at(static_cast<int>(state.range(0)));
