@@ -616,9 +616,11 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
                     weak_step.tail<3>().norm() < kCoarseFactor * options_.converged_rotation_rad;
     }
 
-    scratch_.clear();
-    for (const Correspondence& c : correspondences_) scratch_.push_back(c.distance);
-    gate = std::clamp(4.0 * median(&scratch_), options_.gate_min_m, gate);
+    if (gate > options_.gate_min_m) {  // at its floor (most iterations) the gate stays: no median needed
+      scratch_.clear();
+      for (const Correspondence& c : correspondences_) scratch_.push_back(c.distance);
+      gate = std::clamp(4.0 * median(&scratch_), options_.gate_min_m, gate);
+    }
   }
   // The visibility of the final pose, for the coverage and silhouette checks: most tracking frames end
   // within the tolerance of their prediction, or of the one before (the pose of the frame before, when the
