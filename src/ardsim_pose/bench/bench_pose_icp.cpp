@@ -10,7 +10,8 @@
 // the normals of the model's triangles). Timed for the peers: building their KD-tree over the cropped model
 // (the crop changes every frame) and the alignment; for ours: the whole estimate() from the organized cloud
 // (subsampling, visibility crop, ICP, quality checks, covariance). Counters: mean port position error (m) and
-// attitude error (deg) against the truth over the frames.
+// attitude error (deg) against the truth over the frames; ours also the mean iterations and the fraction of
+// frames it called DEGRADED (at 10 m some stop at the iteration limit while still sliding).
 //
 // PCL twice: as shipped, and with OpenMP regions of one thread run inline (`..InlineOmp`). Debian's FLANN,
 // under PCL's KdTreeFLANN, opens a parallel region of one thread (SearchParams::cores) for every query, and
@@ -168,6 +169,7 @@ void BM_IcpTrack_Ardsim(benchmark::State& state) {
   prime();
   ErrorCounters errors;
   int lost = 0;
+  int degraded = 0;
   double iterations = 0.0;
   std::size_t k = 0;
   for (auto _ : state) {
@@ -176,6 +178,7 @@ void BM_IcpTrack_Ardsim(benchmark::State& state) {
     benchmark::DoNotOptimize(result);
     errors.add(result.T_lidar_target, f);
     iterations += result.iterations;
+    if (result.status == EstimateStatus::kDegraded) ++degraded;
     if (tracker.acquiring()) {  // LOST: back to tracking, untimed
       ++lost;
       state.PauseTiming();
@@ -185,6 +188,7 @@ void BM_IcpTrack_Ardsim(benchmark::State& state) {
   }
   errors.report(state, frames);
   state.counters["lost"] = lost;
+  state.counters["degraded"] = degraded / std::max<double>(1.0, static_cast<double>(k));  // fraction
   state.counters["iterations"] = iterations / std::max<double>(1.0, static_cast<double>(k));
 }
 
