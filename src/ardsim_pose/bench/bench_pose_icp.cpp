@@ -16,9 +16,9 @@
 // PCL twice: as shipped, and with OpenMP regions of one thread run inline (`..InlineOmp`). Debian's FLANN,
 // under PCL's KdTreeFLANN, opens a parallel region of one thread (SearchParams::cores) for every query, and
 // libgomp ends each with a futex wake syscall although nothing waits; where a syscall is dear (a virtual
-// machine) that is half to most of PCL's time (2026-11-23, this 2-core guest: 125 vs 18 ms a 10 m frame), and how
-// dear depends on the host. The inline variant does the same arithmetic (identical transforms) without it:
-// the ratio to it compares the work alone, on any host.
+// machine) that is half to most of PCL's time (2026-11-23, this 2-core guest: 125 vs 18 ms a 10 m frame), and
+// how dear depends on the host. The inline variant does the same arithmetic (identical transforms) without
+// it: the ratio to it compares the work alone, on any host.
 #include <benchmark/benchmark.h>
 #include <dlfcn.h>
 #include <omp.h>
