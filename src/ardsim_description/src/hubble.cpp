@@ -25,11 +25,14 @@ VehicleModel buildHubbleModel(const HubbleOptions& options) {
         Collide::kYes);
 
   // Two solar arrays ~7.1 x 2.6 m [memory] on masts at the aft shroud / equipment section boundary, turning
-  // about their mast (body y) by solar_array_deg; at 0 they face +-z.
+  // about their mast (body y) by solar_array_deg; at 0 they face +-z. The masts are round booms [estimate:
+  // 0.17 m across, 1 m long] that the arrays turn about: turning about its own axis, a cylinder keeps its
+  // surface, so they are rigid structure, in a reference model whatever the arrays' angle (2-3 m off the
+  // axis, they show the roll of Hubble seen end-on).
   for (double side : {-1.0, 1.0}) {
+    b.frustum(at(-1.5, 0, 0) * alongY(), 0.085, 0.085, side > 0 ? 2.0 : -3.0, side > 0 ? 3.0 : -2.0, 16,
+              {skin, b.part("solar_array_masts", false)}, Collide::kYes);
     const Eigen::Isometry3d T_mast = at(-1.5, 0, 0) * rotY(options.solar_array_deg);
-    b.box(T_mast * at(0, side * 2.5, 0), Eigen::Vector3d(0.15, 1.0, 0.15),
-          {skin, b.part("solar_arrays", true)}, Collide::kYes);
     b.box(T_mast * at(0, side * (3.0 + 7.1 / 2), 0), Eigen::Vector3d(2.6, 7.1, 0.04),
           {solar_cell, b.part("solar_arrays", true)}, Collide::kYes);
   }

@@ -93,6 +93,7 @@ void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
   prior_ = T_lidar_target;
   have_good_ = false;
   velocity_valid_ = false;
+  angular_velocity_unlearnt_ = false;
   velocity_mps_.setZero();
   angular_velocity_radps_.setZero();
   have_previous_ = false;
@@ -118,6 +119,7 @@ void PoseEstimator::updateVelocity(const PoseResult& result, double stamp_s) {
   // The jumps of an acquisition are no motion: its estimates reset the velocity.
   if (!have_good_ || result.acquiring || dt <= 0.0 || dt > options_.max_prediction_gap_s) {
     velocity_valid_ = false;
+    angular_velocity_unlearnt_ = false;
     return;
   }
   // Learnt from TRACKING estimates in a row only. A DEGRADED estimate between them keeps the linear velocity
@@ -126,19 +128,31 @@ void PoseEstimator::updateVelocity(const PoseResult& result, double stamp_s) {
   // the angular one (a degraded attitude, most often a barely observed rotation about the boresight, would
   // carry its error into the next prediction: kept, ICP alone on the ISS inside 10 m went from 0.043-0.056 to
   // 0.067-0.132 deg RMS on the approach datasets).
+  const Eigen::Vector3d v = (T.translation() - last_good_.translation()) / dt;
   if (!last_good_tracking_ || result.status != EstimateStatus::kTracking) {
     angular_velocity_radps_.setZero();
+    // With no velocity at all (every estimate since the acquisition DEGRADED: Hubble's ICP frames at 20-50 m,
+    // "not converged" as the roll seen on the solar-array masts wanders), a TRACKING one learns the linear
+    // velocity from a DEGRADED tracking one before (not an acquisition's): predicted without any, the
+    // docking-ring method started 0.5 m off at the approach dataset's 0.5 m a frame, was LOST, and stayed
+    // LOST behind its stale prediction.
+    if (!velocity_valid_ && !last_good_acquiring_ && result.status == EstimateStatus::kTracking) {
+      velocity_mps_ = v;
+      velocity_valid_ = true;
+      angular_velocity_unlearnt_ = true;
+    }
     return;
   }
-  const Eigen::Vector3d v = (T.translation() - last_good_.translation()) / dt;
   Eigen::Vector3d w = rotationVector(T.linear() * last_good_.linear().transpose()) / dt;
   // A rotation about the boresight that the method did not observe (held near its prediction) is no motion:
   // extrapolated, its noise walks the next prediction away (Hubble end-on).
   if (!result.boresight_rotation_observed) w.z() = 0.0;
   const double a = velocity_valid_ ? options_.velocity_smoothing : 1.0;
+  const double a_angular = angular_velocity_unlearnt_ ? 1.0 : a;  // the first pair of TRACKING ones
   velocity_mps_ = a * v + (1.0 - a) * velocity_mps_;
-  angular_velocity_radps_ = a * w + (1.0 - a) * angular_velocity_radps_;
+  angular_velocity_radps_ = a_angular * w + (1.0 - a_angular) * angular_velocity_radps_;
   velocity_valid_ = true;
+  angular_velocity_unlearnt_ = false;
 }
 
 Eigen::Isometry3d PoseEstimator::medianOf(const std::deque<std::pair<double, Eigen::Isometry3d>>& recent,
@@ -259,6 +273,7 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
   if (out.result.status != EstimateStatus::kLost) {
     updateVelocity(out.result, cloud.stamp_s);
     last_good_tracking_ = out.result.status == EstimateStatus::kTracking;
+    last_good_acquiring_ = out.result.acquiring;
     last_good_ = out.result.T_lidar_target;
     last_good_stamp_s = cloud.stamp_s;
     have_good_ = true;

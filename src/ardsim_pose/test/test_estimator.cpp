@@ -144,6 +144,27 @@ TEST(PoseEstimatorPrediction, DegradedKeepsTheLinearVelocityAcquisitionResetsIt)
   EXPECT_LT(position_error(12), 1e-9);
 }
 
+TEST(PoseEstimatorPrediction, TrackingAfterOnlyDegradedLearnsTheLinearVelocity) {
+  // Hubble's ICP at 20-50 m: every tracking estimate since the acquisition DEGRADED, then a TRACKING one.
+  using Step = MotionScript::Step;
+  std::map<int, Step> steps;
+  steps[0] = Step{EstimateStatus::kDegraded, true, true};
+  for (int frame = 1; frame < 5; ++frame) steps[frame] = Step{EstimateStatus::kDegraded, false, true};
+  const std::map<int, Eigen::Isometry3d> predictions = predictionsOver(steps, 8);
+  auto position_error = [&](int frame) {
+    return (predictions.at(frame).translation() - MotionScript::truth(frame).translation()).norm();
+  };
+  // DEGRADED pairs learn nothing: each prediction is the estimate before, a frame (0.5 m) behind.
+  EXPECT_NEAR(position_error(4), 0.5, 1e-9);
+  EXPECT_NEAR(position_error(5), 0.5, 1e-9);
+  // The TRACKING frame 5 learns the linear velocity from the DEGRADED frame 4 (the angular one needs two
+  // TRACKING frames: frame 6 keeps frame 5's attitude); without it frame 6 was predicted 0.5 m behind.
+  EXPECT_LT(position_error(6), 1e-9);
+  EXPECT_NEAR(angleDeg(predictions.at(6), MotionScript::truth(5)), 0.0, 1e-6);
+  EXPECT_LT(position_error(7), 1e-9);
+  EXPECT_LT(angleDeg(predictions.at(7), MotionScript::truth(7)), 1e-6);
+}
+
 TEST(PoseEstimatorPrediction, AnUnobservedBoresightRotationIsNoMotion) {
   using Step = MotionScript::Step;
   std::map<int, Step> steps;

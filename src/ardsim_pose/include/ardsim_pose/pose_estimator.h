@@ -105,10 +105,12 @@ class PoseEstimator {
   bool have_good_ = false;  // a TRACKING or DEGRADED estimate since the prior
   Eigen::Isometry3d last_good_ = Eigen::Isometry3d::Identity();
   bool last_good_tracking_ = false;
+  bool last_good_acquiring_ = false;  // made while acquiring (its jump from the one before is no motion)
   double last_good_stamp_s = 0.0;
   Eigen::Vector3d velocity_mps_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity_radps_ = Eigen::Vector3d::Zero();
   bool velocity_valid_ = false;
+  bool angular_velocity_unlearnt_ = false;  // velocity_valid_ with the linear one alone learnt (no smoothing)
   PoseResult previous_;
   bool have_previous_ = false;
   std::deque<std::pair<double, Eigen::Isometry3d>> recent_;  // (stamp s, good raw estimate), for the filter
