@@ -100,6 +100,14 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/search_lateral_m", &i.search_lateral_m);
   read(nh, "icp/search_lateral_step_m", &i.search_lateral_step_m);
   read(nh, "icp/explained_distance_m", &i.explained_distance_m);
+  PanelOptions& panels = c.panels;
+  read(nh, "panels/enabled", &panels.enabled);
+  read(nh, "panels/min_points", &panels.min_points);
+  read(nh, "panels/min_extent_m", &panels.min_extent_m);
+  read(nh, "panels/max_rms_m", &panels.max_rms_m);
+  read(nh, "panels/min_incidence_deg", &panels.min_incidence_deg);
+  read(nh, "panels/window", &panels.window);
+  read(nh, "panels/rebuild_deg", &panels.rebuild_deg);
   read(nh, "estimator/median_filter", &c.estimator.median_filter);
   read(nh, "estimator/median_window", &c.estimator.median_window);
   read(nh, "estimator/velocity_smoothing", &c.estimator.velocity_smoothing);

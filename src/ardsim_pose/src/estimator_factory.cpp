@@ -1,5 +1,6 @@
 #include "ardsim_pose/estimator_factory.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "ardsim_description/mesh_tools.h"
@@ -20,6 +21,8 @@ void validate(const PoseConfig& c) {
   validate(c.model);
   validate(c.visibility);
   validate(c.icp);
+  validate(c.panels);
+  if (c.panels.enabled) panelJoint(c.target);  // throws for a target without one panel joint
   validate(c.estimator);
 }
 
@@ -41,6 +44,15 @@ void applyTargetDefaults(PoseConfig* config) {
   // datasets, 24 runs, auto): 30-50 m attitude RMS 0.11 -> 0.093 deg mean, within 0.1 deg in 13 -> 17 runs,
   // the rest within +-0.002 deg; ICP frames 30-50 m twice as fast.
   config->icp.converged_rotation_rad = hubble ? 1e-4 : defaults.icp.converged_rotation_rad;
+  // Hubble's two arrays turn on one joint, which the scans measure (PanelTracker): from 50 m in they show its
+  // roll (approach datasets, arrays at 30 deg, 24 runs -> 12: 20-30 m attitude RMS 0.050-0.070 -> 0.012-0.015
+  // deg). The ISS's ten joints are not fitted (its goals are met on the rigid structure alone).
+  config->panels.enabled = hubble;
+  // Edge-on arrays (at 0 deg) show nothing, and a frame's roll on the masts alone is noisy (~1e-3 rad): held
+  // to the constant-velocity prediction with 0.05 deg instead of 0.2, 20-30 m attitude RMS 0.045-0.063 ->
+  // 0.025-0.046 deg (arrays at 0 deg, 12 runs, within 0.05 deg: 2 -> 12; with 0.1 deg: 6); arrays at 30 deg
+  // unchanged (their fit measures the roll).
+  config->icp.boresight_prior_deg = hubble ? 0.05 : defaults.icp.boresight_prior_deg;
   // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43
   // deg RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
   // fills a quarter of the view): the close-range method takes over there (10-20 m: 0.3-0.6 cm, 0.05-0.10
@@ -65,6 +77,21 @@ std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::Ta
       ardsim_description::T_target_port(kind), options);
 }
 
+std::shared_ptr<const ReferenceModel> buildReferenceModelWithPanels(ardsim_description::TargetKind kind,
+                                                                    const ReferenceModelOptions& options,
+                                                                    double panel_angle_rad) {
+  panelJoint(kind);  // throws for a target without one panel joint (only Hubble has one)
+  ardsim_description::HubbleOptions hubble;
+  hubble.solar_array_deg = panel_angle_rad * 180.0 / M_PI;
+  const ardsim_description::TriangleMesh mesh = ardsim_description::buildHubble(hubble);
+  return std::make_shared<const ReferenceModel>(
+      ardsim_description::selectParts(mesh,
+                                      [](const ardsim_description::Part& part) {
+                                        return !part.articulated || part.name == "solar_arrays";
+                                      }),
+      ardsim_description::T_target_port(kind), options);
+}
+
 std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config) {
   validate(config);
   return makeEstimator(config, buildReferenceModel(config.target, config.model));
@@ -74,8 +101,16 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
                                              std::shared_ptr<const ReferenceModel> model) {
   validate(config);
   PoseEstimator::Methods methods;
-  methods[EstimateMethod::kIcp] = std::make_unique<IcpTracker>(
-      std::move(model), ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
+  auto icp = std::make_unique<IcpTracker>(model, ardsim_lidar::intrinsicsFor(config.sensor), config.icp,
+                                          config.visibility);
+  if (config.panels.enabled) {
+    icp->trackPanels(
+        std::make_unique<PanelTracker>(panelJoint(config.target), config.panels, std::move(model),
+                                       [target = config.target, options = config.model](double angle_rad) {
+                                         return buildReferenceModelWithPanels(target, options, angle_rad);
+                                       }));
+  }
+  methods[EstimateMethod::kIcp] = std::move(icp);
   const close_range::AdapterGeometry geometry = close_range::adapterGeometry(config.target);
   methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, config.ring);
   methods[EstimateMethod::kPyramid] = std::make_unique<close_range::PyramidMethod>(geometry, config.pyramid);

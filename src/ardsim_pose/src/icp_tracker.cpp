@@ -155,6 +155,12 @@ IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model,
   for (int u = 0; u < intrinsics_.width; ++u) column_cells_[u] = this->visibility().cellOfPixel(u, 0);
 }
 
+void IcpTracker::replaceModel(std::shared_ptr<const ReferenceModel> model) {
+  model_ = std::move(model);
+  for (VisibilitySlot& slot : slots_) slot.valid = false;
+  ++visibility_generation_;
+}
+
 double IcpTracker::coverage() const {
   // Of the cells where the model is predicted (inside the image), the fraction where the scan has a return
   // near the predicted depth: a different object, or the right object at a wrong pose, leaves most of them
@@ -920,6 +926,10 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   } else {
     result.status = EstimateStatus::kDegraded;
     for (const std::string& reason : degraded) result.reason += (result.reason.empty() ? "" : "; ") + reason;
+  }
+  if (panels_) {
+    if (std::shared_ptr<const ReferenceModel> model = panels_->update(cloud, result.T_lidar_target))
+      replaceModel(std::move(model));
   }
   return result;
 }

@@ -12,6 +12,7 @@
 #include "ardsim_pose/close_range/pyramid.h"
 #include "ardsim_pose/close_range/ring_detector.h"
 #include "ardsim_pose/icp_tracker.h"
+#include "ardsim_pose/panel_angle.h"
 #include "ardsim_pose/pose_estimator.h"
 #include "ardsim_pose/reference_model.h"
 
@@ -27,6 +28,7 @@ struct PoseConfig {
   ReferenceModelOptions model;
   VisibilityOptions visibility;
   IcpOptions icp;
+  PanelOptions panels;  // ICP's model follows the panels' measured angle (Hubble's arrays)
   EstimatorOptions estimator;
   close_range::RingDetectorOptions ring;
   close_range::PyramidOptions pyramid;
@@ -48,6 +50,10 @@ void validate(const PoseConfig& config);
 // The rigid structure (articulated parts left out) of the target, sampled.
 std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::TargetKind kind,
                                                           const ReferenceModelOptions& options);
+// The rigid structure and the panels of panelJoint(kind) at panel_angle_rad, sampled.
+std::shared_ptr<const ReferenceModel> buildReferenceModelWithPanels(ardsim_description::TargetKind kind,
+                                                                    const ReferenceModelOptions& options,
+                                                                    double panel_angle_rad);
 
 std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config);
 // The same with a model already built (it is shared, read-only, between estimators).

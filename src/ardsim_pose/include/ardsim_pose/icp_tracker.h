@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "ardsim_lidar/sensor.h"
+#include "ardsim_pose/panel_angle.h"
 #include "ardsim_pose/pose_types.h"
 #include "ardsim_pose/reference_model.h"
 
@@ -101,6 +102,10 @@ class IcpTracker : public PoseMethod {
  public:
   IcpTracker(std::shared_ptr<const ReferenceModel> model, const ardsim_lidar::Intrinsics& intrinsics,
              const IcpOptions& options = {}, const VisibilityOptions& visibility = {});
+  // Tracked frames measure the target's panels and the reference model follows them (PanelTracker): the
+  // model given above is then the rigid structure alone.
+  void trackPanels(std::unique_ptr<PanelTracker> panels) { panels_ = std::move(panels); }
+  const PanelTracker* panels() const { return panels_.get(); }
 
   PoseResult estimate(const OrganizedCloud& cloud,
                       const Eigen::Isometry3d& T_lidar_target_predicted) override;
@@ -192,7 +197,12 @@ class IcpTracker : public PoseMethod {
   // a visibility prediction within tolerance_px of T (predictVisibility).
   void gateToSilhouette(const Eigen::Isometry3d& T, double margin_px, double tolerance_px);
 
+  // From the next frame on, model in place of model_ (the visibility predictions and balls made with the
+  // old one are dropped).
+  void replaceModel(std::shared_ptr<const ReferenceModel> model);
+
   std::shared_ptr<const ReferenceModel> model_;
+  std::unique_ptr<PanelTracker> panels_;
   ardsim_lidar::Intrinsics intrinsics_;
   IcpOptions options_;
   // The last two visibility predictions: tracking returns to the pose of the frame before after a
