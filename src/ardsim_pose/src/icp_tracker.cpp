@@ -9,6 +9,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "require_option.h"
+
 namespace ardsim_pose {
 
 namespace {
@@ -36,10 +38,6 @@ constexpr int kGridBuildRatio = 60;
 // The coverage and silhouette checks of a final pose take a visibility prediction made at a pose that moves
 // every visible model point less than one of its 4 px cells in the image (they allow a cell or more).
 constexpr double kVisibilityTolerancePx = 4.0;
-
-void require(bool ok, const std::string& name, double value, const std::string& allowed) {
-  if (!ok) throw std::invalid_argument(name + " = " + std::to_string(value) + " is out of range: " + allowed);
-}
 
 bool positive(double v) {
   return std::isfinite(v) && v > 0.0;
@@ -76,68 +74,72 @@ std::string format(const char* pattern, double a, double b = 0.0) {
 }  // namespace
 
 void validate(const IcpOptions& o) {
-  require(o.max_points >= 50 && o.max_points <= 100000, "icp/max_points", o.max_points, "50 .. 100000");
-  require(o.max_points_near >= 50 && o.max_points_near <= 100000, "icp/max_points_near", o.max_points_near,
-          "50 .. 100000");
-  require(std::isfinite(o.near_depth_m) && o.near_depth_m >= 0.0 && o.near_depth_m <= 1000.0,
-          "icp/near_depth_m", o.near_depth_m, "0 .. 1000");
-  require(o.max_iterations_tracking >= 1 && o.max_iterations_tracking <= 200, "icp/max_iterations_tracking",
-          o.max_iterations_tracking, "1 .. 200");
-  require(o.max_iterations_acquisition >= 1 && o.max_iterations_acquisition <= 500,
-          "icp/max_iterations_acquisition", o.max_iterations_acquisition, "1 .. 500");
-  require(positive(o.gate_min_m), "icp/gate_min_m", o.gate_min_m, "> 0");
-  require(positive(o.gate_tracking_m) && o.gate_tracking_m >= o.gate_min_m, "icp/gate_tracking_m",
-          o.gate_tracking_m, ">= gate_min_m");
-  require(positive(o.gate_acquisition_m) && o.gate_acquisition_m >= o.gate_min_m, "icp/gate_acquisition_m",
-          o.gate_acquisition_m, ">= gate_min_m");
-  require(positive(o.tukey_c), "icp/tukey_c", o.tukey_c, "> 0");
-  require(fraction(o.weak_direction_condition), "icp/weak_direction_condition", o.weak_direction_condition,
-          "0 .. 1");
-  require(positive(o.degraded_weak_slide_px), "icp/degraded_weak_slide_px", o.degraded_weak_slide_px, "> 0");
-  require(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
-  require(
+  requireOption(o.max_points >= 50 && o.max_points <= 100000, "icp/max_points", o.max_points, "50 .. 100000");
+  requireOption(o.max_points_near >= 50 && o.max_points_near <= 100000, "icp/max_points_near",
+                o.max_points_near, "50 .. 100000");
+  requireOption(std::isfinite(o.near_depth_m) && o.near_depth_m >= 0.0 && o.near_depth_m <= 1000.0,
+                "icp/near_depth_m", o.near_depth_m, "0 .. 1000");
+  requireOption(o.max_iterations_tracking >= 1 && o.max_iterations_tracking <= 200,
+                "icp/max_iterations_tracking", o.max_iterations_tracking, "1 .. 200");
+  requireOption(o.max_iterations_acquisition >= 1 && o.max_iterations_acquisition <= 500,
+                "icp/max_iterations_acquisition", o.max_iterations_acquisition, "1 .. 500");
+  requireOption(positive(o.gate_min_m), "icp/gate_min_m", o.gate_min_m, "> 0");
+  requireOption(positive(o.gate_tracking_m) && o.gate_tracking_m >= o.gate_min_m, "icp/gate_tracking_m",
+                o.gate_tracking_m, ">= gate_min_m");
+  requireOption(positive(o.gate_acquisition_m) && o.gate_acquisition_m >= o.gate_min_m,
+                "icp/gate_acquisition_m", o.gate_acquisition_m, ">= gate_min_m");
+  requireOption(positive(o.tukey_c), "icp/tukey_c", o.tukey_c, "> 0");
+  requireOption(fraction(o.weak_direction_condition), "icp/weak_direction_condition",
+                o.weak_direction_condition, "0 .. 1");
+  requireOption(positive(o.degraded_weak_slide_px), "icp/degraded_weak_slide_px", o.degraded_weak_slide_px,
+                "> 0");
+  requireOption(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
+  requireOption(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
       "icp/boresight_prior_deg", o.boresight_prior_deg, "0 .. 180");
-  require(std::isfinite(o.crop_reuse_px) && o.crop_reuse_px >= 0.0 && o.crop_reuse_px <= 4.0,
-          "icp/crop_reuse_px", o.crop_reuse_px, "0 .. 4");
-  require(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
-          "> 0");
-  require(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad, "> 0");
-  require(positive(o.revisibility_translation_m), "icp/revisibility_translation_m",
-          o.revisibility_translation_m, "> 0");
-  require(positive(o.revisibility_rotation_rad), "icp/revisibility_rotation_rad", o.revisibility_rotation_rad,
-          "> 0");
-  require(std::isfinite(o.silhouette_margin_px) && o.silhouette_margin_px >= 0.0 &&
-              o.silhouette_margin_px <= 256.0,
-          "icp/silhouette_margin_px", o.silhouette_margin_px, "0 .. 256");
-  require(o.min_points >= 6 && o.min_points <= std::min(o.max_points, o.max_points_near), "icp/min_points",
-          o.min_points, "6 .. max_points and max_points_near");
-  require(fraction(o.lost_inlier_fraction), "icp/lost_inlier_fraction", o.lost_inlier_fraction, "0 .. 1");
-  require(fraction(o.degraded_inlier_fraction) && o.degraded_inlier_fraction >= o.lost_inlier_fraction,
-          "icp/degraded_inlier_fraction", o.degraded_inlier_fraction, "lost_inlier_fraction .. 1");
-  require(positive(o.lost_fit_rms_m), "icp/lost_fit_rms_m", o.lost_fit_rms_m, "> 0");
-  require(positive(o.degraded_fit_rms_m) && o.degraded_fit_rms_m <= o.lost_fit_rms_m,
-          "icp/degraded_fit_rms_m", o.degraded_fit_rms_m, "> 0 .. lost_fit_rms_m");
-  require(fraction(o.lost_coverage), "icp/lost_coverage", o.lost_coverage, "0 .. 1");
-  require(fraction(o.degraded_coverage) && o.degraded_coverage >= o.lost_coverage, "icp/degraded_coverage",
-          o.degraded_coverage, "lost_coverage .. 1");
-  require(fraction(o.degraded_condition), "icp/degraded_condition", o.degraded_condition, "0 .. 1");
-  require(positive(o.confirm_translation_m), "icp/confirm_translation_m", o.confirm_translation_m, "> 0");
-  require(positive(o.confirm_rotation_rad), "icp/confirm_rotation_rad", o.confirm_rotation_rad, "> 0");
-  require(positive(o.max_correction_m), "icp/max_correction_m", o.max_correction_m, "> 0");
-  require(positive(o.max_correction_rad), "icp/max_correction_rad", o.max_correction_rad, "> 0");
-  require(o.search_iterations >= 1 && o.search_iterations <= o.max_iterations_acquisition,
-          "icp/search_iterations", o.search_iterations, "1 .. max_iterations_acquisition");
-  require(std::isfinite(o.search_offset_m) && o.search_offset_m >= 0.0 && o.search_offset_m <= 20.0,
-          "icp/search_offset_m", o.search_offset_m, "0 .. 20");
-  require(std::isfinite(o.search_lateral_m) && o.search_lateral_m >= 0.0 && o.search_lateral_m <= 20.0,
-          "icp/search_lateral_m", o.search_lateral_m, "0 .. 20");
-  require(positive(o.search_lateral_step_m) && o.search_lateral_step_m >= o.search_lateral_m / 20.0,
-          "icp/search_lateral_step_m", o.search_lateral_step_m, "> 0, >= search_lateral_m / 20");
-  require(
+  requireOption(std::isfinite(o.crop_reuse_px) && o.crop_reuse_px >= 0.0 && o.crop_reuse_px <= 4.0,
+                "icp/crop_reuse_px", o.crop_reuse_px, "0 .. 4");
+  requireOption(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
+                "> 0");
+  requireOption(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad,
+                "> 0");
+  requireOption(positive(o.revisibility_translation_m), "icp/revisibility_translation_m",
+                o.revisibility_translation_m, "> 0");
+  requireOption(positive(o.revisibility_rotation_rad), "icp/revisibility_rotation_rad",
+                o.revisibility_rotation_rad, "> 0");
+  requireOption(std::isfinite(o.silhouette_margin_px) && o.silhouette_margin_px >= 0.0 &&
+                    o.silhouette_margin_px <= 256.0,
+                "icp/silhouette_margin_px", o.silhouette_margin_px, "0 .. 256");
+  requireOption(o.min_points >= 6 && o.min_points <= std::min(o.max_points, o.max_points_near),
+                "icp/min_points", o.min_points, "6 .. max_points and max_points_near");
+  requireOption(fraction(o.lost_inlier_fraction), "icp/lost_inlier_fraction", o.lost_inlier_fraction,
+                "0 .. 1");
+  requireOption(fraction(o.degraded_inlier_fraction) && o.degraded_inlier_fraction >= o.lost_inlier_fraction,
+                "icp/degraded_inlier_fraction", o.degraded_inlier_fraction, "lost_inlier_fraction .. 1");
+  requireOption(positive(o.lost_fit_rms_m), "icp/lost_fit_rms_m", o.lost_fit_rms_m, "> 0");
+  requireOption(positive(o.degraded_fit_rms_m) && o.degraded_fit_rms_m <= o.lost_fit_rms_m,
+                "icp/degraded_fit_rms_m", o.degraded_fit_rms_m, "> 0 .. lost_fit_rms_m");
+  requireOption(fraction(o.lost_coverage), "icp/lost_coverage", o.lost_coverage, "0 .. 1");
+  requireOption(fraction(o.degraded_coverage) && o.degraded_coverage >= o.lost_coverage,
+                "icp/degraded_coverage", o.degraded_coverage, "lost_coverage .. 1");
+  requireOption(fraction(o.degraded_condition), "icp/degraded_condition", o.degraded_condition, "0 .. 1");
+  requireOption(positive(o.confirm_translation_m), "icp/confirm_translation_m", o.confirm_translation_m,
+                "> 0");
+  requireOption(positive(o.confirm_rotation_rad), "icp/confirm_rotation_rad", o.confirm_rotation_rad, "> 0");
+  requireOption(positive(o.max_correction_m), "icp/max_correction_m", o.max_correction_m, "> 0");
+  requireOption(positive(o.max_correction_rad), "icp/max_correction_rad", o.max_correction_rad, "> 0");
+  requireOption(o.search_iterations >= 1 && o.search_iterations <= o.max_iterations_acquisition,
+                "icp/search_iterations", o.search_iterations, "1 .. max_iterations_acquisition");
+  requireOption(std::isfinite(o.search_offset_m) && o.search_offset_m >= 0.0 && o.search_offset_m <= 20.0,
+                "icp/search_offset_m", o.search_offset_m, "0 .. 20");
+  requireOption(std::isfinite(o.search_lateral_m) && o.search_lateral_m >= 0.0 && o.search_lateral_m <= 20.0,
+                "icp/search_lateral_m", o.search_lateral_m, "0 .. 20");
+  requireOption(positive(o.search_lateral_step_m) && o.search_lateral_step_m >= o.search_lateral_m / 20.0,
+                "icp/search_lateral_step_m", o.search_lateral_step_m, "> 0, >= search_lateral_m / 20");
+  requireOption(
       std::isfinite(o.search_rotation_rad) && o.search_rotation_rad >= 0.0 && o.search_rotation_rad <= 1.0,
       "icp/search_rotation_rad", o.search_rotation_rad, "0 .. 1");
-  require(positive(o.explained_distance_m), "icp/explained_distance_m", o.explained_distance_m, "> 0");
+  requireOption(positive(o.explained_distance_m), "icp/explained_distance_m", o.explained_distance_m, "> 0");
 }
 
 IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model,

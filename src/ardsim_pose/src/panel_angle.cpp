@@ -7,6 +7,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "require_option.h"
+
 namespace ardsim_pose {
 
 namespace {
@@ -18,6 +20,12 @@ constexpr double kMarginM = 0.15;
 // angle + k pi nearest to reference.
 double nearestTurn(double angle_rad, double reference_rad) {
   return angle_rad - M_PI * std::round((angle_rad - reference_rad) / M_PI);
+}
+
+// angle + k pi in [-pi/2, pi/2).
+double halfTurnRange(double angle_rad) {
+  const double a = nearestTurn(angle_rad, 0.0);
+  return a >= M_PI / 2 ? a - M_PI : a;
 }
 
 struct LineFit {
@@ -62,19 +70,17 @@ PanelJoint panelJoint(ardsim_description::TargetKind kind) {
 }
 
 void validate(const PanelOptions& o) {
-  auto require = [](bool ok, const std::string& name, double value, const std::string& allowed) {
-    if (!ok)
-      throw std::invalid_argument(name + " = " + std::to_string(value) + " is out of range: " + allowed);
-  };
-  require(o.min_points >= 10, "panels/min_points", o.min_points, ">= 10");
-  require(std::isfinite(o.min_extent_m) && o.min_extent_m > 0.0, "panels/min_extent_m", o.min_extent_m,
-          "> 0");
-  require(std::isfinite(o.max_rms_m) && o.max_rms_m > 0.0, "panels/max_rms_m", o.max_rms_m, "> 0");
-  require(std::isfinite(o.min_incidence_deg) && o.min_incidence_deg >= 0.0 && o.min_incidence_deg < 90.0,
-          "panels/min_incidence_deg", o.min_incidence_deg, "0..90 (exclusive)");
-  require(o.window >= 1 && o.window <= 99 && o.window % 2 == 1, "panels/window", o.window, "odd, 1..99");
-  require(std::isfinite(o.rebuild_deg) && o.rebuild_deg >= 0.01 && o.rebuild_deg <= 10.0,
-          "panels/rebuild_deg", o.rebuild_deg, "0.01..10");
+  requireOption(o.min_points >= 10, "panels/min_points", o.min_points, ">= 10");
+  requireOption(std::isfinite(o.min_extent_m) && o.min_extent_m > 0.0, "panels/min_extent_m", o.min_extent_m,
+                "> 0");
+  requireOption(std::isfinite(o.max_rms_m) && o.max_rms_m > 0.0, "panels/max_rms_m", o.max_rms_m, "> 0");
+  requireOption(
+      std::isfinite(o.min_incidence_deg) && o.min_incidence_deg >= 0.0 && o.min_incidence_deg < 90.0,
+      "panels/min_incidence_deg", o.min_incidence_deg, "0..90 (exclusive)");
+  requireOption(o.window >= 1 && o.window <= 99 && o.window % 2 == 1, "panels/window", o.window,
+                "odd, 1..99");
+  requireOption(std::isfinite(o.rebuild_deg) && o.rebuild_deg >= 0.01 && o.rebuild_deg <= 10.0,
+                "panels/rebuild_deg", o.rebuild_deg, "0.01..10");
 }
 
 bool fitPanelAngle(const PanelJoint& joint, const OrganizedCloud& cloud,
@@ -123,8 +129,7 @@ bool fitPanelAngle(const PanelJoint& joint, const OrganizedCloud& cloud,
   }
   fit->extent_m = high - low;
   fit->rms_m = line.rms_m;
-  fit->angle_rad = nearestTurn(std::atan2(line.direction.y(), line.direction.x()), 0.0);
-  if (fit->angle_rad >= M_PI / 2) fit->angle_rad -= M_PI;
+  fit->angle_rad = halfTurnRange(std::atan2(line.direction.y(), line.direction.x()));
   if (fit->extent_m < options.min_extent_m || fit->rms_m > options.max_rms_m) return false;
   const Eigen::Vector3d across_panels =
       std::cos(fit->angle_rad) * joint.zero_direction + std::sin(fit->angle_rad) * across_axis;
@@ -164,8 +169,7 @@ std::shared_ptr<const ReferenceModel> PanelTracker::update(const OrganizedCloud&
   if (model_has_panels_ && std::abs(nearestTurn(median_rad, model_angle_rad_) - model_angle_rad_) <=
                                options_.rebuild_deg * M_PI / 180.0)
     return nullptr;
-  model_angle_rad_ = nearestTurn(median_rad, 0.0);
-  if (model_angle_rad_ >= M_PI / 2) model_angle_rad_ -= M_PI;
+  model_angle_rad_ = halfTurnRange(median_rad);
   model_has_panels_ = true;
   // Keep the window near the new angle (its fits unwrapped against it from now on).
   for (double& a : recent_rad_) a = nearestTurn(a, model_angle_rad_);

@@ -11,13 +11,11 @@
 
 #include <nanoflann.hpp>
 
+#include "require_option.h"
+
 namespace ardsim_pose {
 
 namespace {
-
-void require(bool ok, const std::string& name, double value, const std::string& allowed) {
-  if (!ok) throw std::invalid_argument(name + " = " + std::to_string(value) + " is out of range: " + allowed);
-}
 
 // Points of a triangle from the R2 low-discrepancy sequence folded into the triangle: even coverage without a
 // random generator, the same model on every run.
@@ -40,25 +38,28 @@ void sampleTriangle(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Ei
 }  // namespace
 
 void validate(const ReferenceModelOptions& o) {
-  require(std::isfinite(o.spacing_at_port_m) && o.spacing_at_port_m >= 0.005 && o.spacing_at_port_m <= 1.0,
-          "model/spacing_at_port_m", o.spacing_at_port_m, "0.005 .. 1");
-  require(
+  requireOption(
+      std::isfinite(o.spacing_at_port_m) && o.spacing_at_port_m >= 0.005 && o.spacing_at_port_m <= 1.0,
+      "model/spacing_at_port_m", o.spacing_at_port_m, "0.005 .. 1");
+  requireOption(
       std::isfinite(o.spacing_growth_per_m) && o.spacing_growth_per_m >= 0.0 && o.spacing_growth_per_m <= 0.1,
       "model/spacing_growth_per_m", o.spacing_growth_per_m, "0 .. 0.1");
-  require(std::isfinite(o.max_spacing_m) && o.max_spacing_m >= o.spacing_at_port_m && o.max_spacing_m <= 2.0,
-          "model/max_spacing_m", o.max_spacing_m, "spacing_at_port_m .. 2");
-  require(std::isfinite(o.patch_spacings) && o.patch_spacings >= 1.0 && o.patch_spacings <= 20.0,
-          "model/patch_spacings", o.patch_spacings, "1 .. 20");
-  require(std::isfinite(o.chunk_size_m) && o.chunk_size_m >= 0.5 && o.chunk_size_m <= 50.0,
-          "model/chunk_size_m", o.chunk_size_m, "0.5 .. 50");
+  requireOption(
+      std::isfinite(o.max_spacing_m) && o.max_spacing_m >= o.spacing_at_port_m && o.max_spacing_m <= 2.0,
+      "model/max_spacing_m", o.max_spacing_m, "spacing_at_port_m .. 2");
+  requireOption(std::isfinite(o.patch_spacings) && o.patch_spacings >= 1.0 && o.patch_spacings <= 20.0,
+                "model/patch_spacings", o.patch_spacings, "1 .. 20");
+  requireOption(std::isfinite(o.chunk_size_m) && o.chunk_size_m >= 0.5 && o.chunk_size_m <= 50.0,
+                "model/chunk_size_m", o.chunk_size_m, "0.5 .. 50");
 }
 
 void validate(const VisibilityOptions& o) {
-  require(o.cell_px >= 1 && o.cell_px <= 32, "visibility/cell_px", o.cell_px, "1 .. 32");
-  require(std::isfinite(o.margin_px) && o.margin_px >= 0.0 && o.margin_px <= 256.0, "visibility/margin_px",
-          o.margin_px, "0 .. 256");
-  require(std::isfinite(o.depth_tolerance_m) && o.depth_tolerance_m > 0.0 && o.depth_tolerance_m <= 10.0,
-          "visibility/depth_tolerance_m", o.depth_tolerance_m, "> 0 .. 10");
+  requireOption(o.cell_px >= 1 && o.cell_px <= 32, "visibility/cell_px", o.cell_px, "1 .. 32");
+  requireOption(std::isfinite(o.margin_px) && o.margin_px >= 0.0 && o.margin_px <= 256.0,
+                "visibility/margin_px", o.margin_px, "0 .. 256");
+  requireOption(
+      std::isfinite(o.depth_tolerance_m) && o.depth_tolerance_m > 0.0 && o.depth_tolerance_m <= 10.0,
+      "visibility/depth_tolerance_m", o.depth_tolerance_m, "> 0 .. 10");
 }
 
 // nanoflann adaptor over the model points.

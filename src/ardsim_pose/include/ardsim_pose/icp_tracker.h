@@ -105,7 +105,6 @@ class IcpTracker : public PoseMethod {
   // Tracked frames measure the target's panels and the reference model follows them (PanelTracker): the
   // model given above is then the rigid structure alone.
   void trackPanels(std::unique_ptr<PanelTracker> panels) { panels_ = std::move(panels); }
-  const PanelTracker* panels() const { return panels_.get(); }
 
   PoseResult estimate(const OrganizedCloud& cloud,
                       const Eigen::Isometry3d& T_lidar_target_predicted) override;

@@ -85,7 +85,6 @@ class PanelTracker {
   std::shared_ptr<const ReferenceModel> update(const OrganizedCloud& cloud,
                                                const Eigen::Isometry3d& T_lidar_target);
   bool modelHasPanels() const { return model_has_panels_; }
-  double modelAngleRad() const { return model_angle_rad_; }
   const PanelFit& lastFit() const { return last_fit_; }
 
  private:
