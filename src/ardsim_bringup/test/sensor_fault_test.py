@@ -15,8 +15,10 @@ DROP, BLIND = (10.0, 12.0), (20.0, 30.0)
 
 class SensorFault(unittest.TestCase):
     def test_holds_or_retreats_and_never_collides(self):
+        # At most 5x real time: the recorder is outside the lockstep, and unthrottled (~22x) on a loaded machine it
+        # dropped clouds, 100 or fewer of the ~120 in the fault intervals (session 17).
         out, s = run_scenario(self, os.path.join(SCENARIOS, "sensor_fault_short.yaml"), "rviz:=none",
-                              "pose_source:=truth")
+                              "pose_source:=truth", "real_time_factor:=5")
         self.assertFalse(s["collision"], s["reason"])
         self.assertFalse(s["docked"], "docked although the sensor was blind for 10 s")
         self.assertTrue(s["aborted"] or s["final_phase"] == "HOLD", "outcome %s, final phase %s" %
