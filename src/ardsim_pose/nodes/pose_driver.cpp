@@ -77,6 +77,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/degraded_weak_slide_px", &i.degraded_weak_slide_px);
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/boresight_prior_deg", &i.boresight_prior_deg);
+  read(nh, "icp/acquisition_boresight_gate_deg", &i.acquisition_boresight_gate_deg);
   read(nh, "icp/crop_reuse_px", &i.crop_reuse_px);
   read(nh, "icp/converged_translation_m", &i.converged_translation_m);
   read(nh, "icp/converged_rotation_rad", &i.converged_rotation_rad);
@@ -107,6 +108,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "panels/max_rms_m", &panels.max_rms_m);
   read(nh, "panels/min_incidence_deg", &panels.min_incidence_deg);
   read(nh, "panels/window", &panels.window);
+  read(nh, "panels/first_window", &panels.first_window);
   read(nh, "panels/rebuild_deg", &panels.rebuild_deg);
   read(nh, "estimator/median_filter", &c.estimator.median_filter);
   read(nh, "estimator/median_window", &c.estimator.median_window);

@@ -97,6 +97,9 @@ void validate(const IcpOptions& o) {
   requireOption(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
       "icp/boresight_prior_deg", o.boresight_prior_deg, "0 .. 180");
+  requireOption(std::isfinite(o.acquisition_boresight_gate_deg) && o.acquisition_boresight_gate_deg >= 0.0 &&
+                    o.acquisition_boresight_gate_deg <= 180.0,
+                "icp/acquisition_boresight_gate_deg", o.acquisition_boresight_gate_deg, "0 .. 180");
   requireOption(std::isfinite(o.crop_reuse_px) && o.crop_reuse_px >= 0.0 && o.crop_reuse_px <= 4.0,
                 "icp/crop_reuse_px", o.crop_reuse_px, "0 .. 4");
   requireOption(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
@@ -471,7 +474,8 @@ int IcpTracker::nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, f
 }
 
 IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double gate, int max_iterations,
-                                        bool tracking, int stride) {
+                                        bool tracking, int stride,
+                                        const Eigen::Isometry3d* T_boresight_prior) {
   Alignment a;
   a.T = T_start;
   const auto selectActive = [&](int every) {
@@ -581,10 +585,11 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       // sigma squared over the prior's). Without it the rotation wandered 10-20 deg a frame on noise there.
       Eigen::Matrix<double, 6, 6> H_solve = a.H;
       Eigen::Matrix<double, 6, 1> g_solve = g;
-      if (tracking && options_.boresight_prior_deg > 0.0 && !boresight_well_observed) {
-        const double prior_rad = options_.boresight_prior_deg * M_PI / 180.0;
+      const Eigen::Isometry3d* T_prior = tracking ? &T_start : T_boresight_prior;
+      if (T_prior != nullptr && options_.boresight_prior_deg > 0.0 && !boresight_well_observed) {
+        const double prior_rad = (tracking ? 1.0 : 2.0) * options_.boresight_prior_deg * M_PI / 180.0;
         const double information = sigma * sigma / (prior_rad * prior_rad);
-        const Eigen::AngleAxisd turn(T.linear() * T_start.linear().transpose());
+        const Eigen::AngleAxisd turn(T.linear() * T_prior->linear().transpose());
         H_solve(5, 5) += information;
         g_solve(5) -= information * turn.angle() * turn.axis().z();
       }
@@ -725,7 +730,17 @@ IcpTracker::Alignment IcpTracker::acquire(const Eigen::Isometry3d& T_prior) {
   for (std::size_t k = 0; k < keep; ++k) hypotheses.push_back(cells[k].T);
   const Alignment fine = bestOf(hypotheses, options_.gate_tracking_m);
   if (!fine.failure.empty()) return fine;
-  return align(fine.T, options_.gate_tracking_m, options_.max_iterations_acquisition, false, 1);
+  const Alignment own =
+      align(fine.T, options_.gate_tracking_m, options_.max_iterations_acquisition, false, 1);
+  // 3. From the second acquisition frame on, a barely observed boresight rotation near the prediction's is
+  // held near it (IcpOptions::acquisition_boresight_gate_deg).
+  if (!own.failure.empty() || acquired_.empty() || options_.acquisition_boresight_gate_deg <= 0.0) return own;
+  const Eigen::AngleAxisd turn(own.T.linear() * T_prior.linear().transpose());
+  if (std::abs(turn.angle() * turn.axis().z()) > options_.acquisition_boresight_gate_deg * M_PI / 180.0)
+    return own;
+  const Alignment held =
+      align(own.T, options_.gate_tracking_m, options_.max_iterations_acquisition, false, 1, &T_prior);
+  return held.failure.empty() ? held : own;
 }
 
 bool IcpTracker::extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const {

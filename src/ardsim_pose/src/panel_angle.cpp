@@ -79,6 +79,8 @@ void validate(const PanelOptions& o) {
       "panels/min_incidence_deg", o.min_incidence_deg, "0..90 (exclusive)");
   requireOption(o.window >= 1 && o.window <= 99 && o.window % 2 == 1, "panels/window", o.window,
                 "odd, 1..99");
+  requireOption(o.first_window >= 1 && o.first_window <= o.window && o.first_window % 2 == 1,
+                "panels/first_window", o.first_window, "odd, 1..window");
   requireOption(std::isfinite(o.rebuild_deg) && o.rebuild_deg >= 0.01 && o.rebuild_deg <= 10.0,
                 "panels/rebuild_deg", o.rebuild_deg, "0.01..10");
 }
@@ -162,7 +164,8 @@ std::shared_ptr<const ReferenceModel> PanelTracker::update(const OrganizedCloud&
                                    : (recent_rad_.empty() ? last_fit_.angle_rad : recent_rad_.front());
   recent_rad_.push_back(nearestTurn(last_fit_.angle_rad, reference_rad));
   if (static_cast<int>(recent_rad_.size()) > options_.window) recent_rad_.erase(recent_rad_.begin());
-  if (static_cast<int>(recent_rad_.size()) < options_.window) return nullptr;
+  if (static_cast<int>(recent_rad_.size()) < (model_has_panels_ ? options_.window : options_.first_window))
+    return nullptr;
   std::vector<double> sorted = recent_rad_;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const double median_rad = sorted[sorted.size() / 2];

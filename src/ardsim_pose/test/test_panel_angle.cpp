@@ -1,6 +1,7 @@
 // Hubble's solar-array angle measured on rendered frames (the lidar core, in-process): a frame's fit at the
-// true pose, none when the arrays are edge-on or absent, the tracker's model rebuilt once at the median and
-// again only when the arrays turn, and ICP's attitude with the arrays turned 30 deg from the rigid model.
+// true pose, none when the arrays are edge-on or absent, the tracker's model built at the median of the first
+// fits and rebuilt only when the arrays turn, and ICP's attitude with the arrays turned 30 deg from the rigid
+// model.
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -95,14 +96,15 @@ TEST(PanelTracker, BuildsTheModelAtTheMedianAndRebuildsWhenTheArraysTurn) {
       tracker.update(cloud, truth);
     }
   };
-  frames(30.0, config.panels.window - 1, 1);
-  EXPECT_TRUE(built_deg.empty()) << "built before a window of fits";
+  ASSERT_LT(config.panels.first_window, config.panels.window);
+  frames(30.0, config.panels.first_window - 1, 1);
+  EXPECT_TRUE(built_deg.empty()) << "built before first_window fits";
   EXPECT_FALSE(tracker.modelHasPanels());
   frames(30.0, 1, 20);
   ASSERT_EQ(built_deg.size(), 1u);
   EXPECT_NEAR(built_deg[0], 30.0, 0.1);
   EXPECT_TRUE(tracker.modelHasPanels());
-  frames(30.0, 6, 30);  // the same angle: the median stays within rebuild_deg
+  frames(30.0, config.panels.window, 30);  // the same angle: the window's median stays within rebuild_deg
   EXPECT_EQ(built_deg.size(), 1u);
   frames(32.0, config.panels.window / 2 + 1, 40);  // a majority of the window at 32 deg
   ASSERT_EQ(built_deg.size(), 2u);
@@ -121,8 +123,9 @@ TEST(PanelTracker, ArraysTurnedNearlyEdgeOnLeaveTheModel) {
                        [&](double) { return with_panels; });
   Eigen::Isometry3d truth;
   std::shared_ptr<const ReferenceModel> model;
-  for (int k = 0; k < config.panels.window; ++k)
-    model = tracker.update(renderHubble(30.0, 30.0, 1 + k, &truth), truth);
+  for (int k = 0; k < config.panels.window; ++k) {
+    if (auto built = tracker.update(renderHubble(30.0, 30.0, 1 + k, &truth), truth)) model = built;
+  }
   ASSERT_EQ(model, with_panels);
   EXPECT_NEAR(tracker.lastFit().incidence_deg, 30.0, 1.0);
   for (int k = 0; k < config.panels.window; ++k) {
@@ -163,7 +166,7 @@ TEST(PanelTracker, ArraysTurnedFromTheModelAreMeasuredAndTracked) {
     // ICP alone (the ring's position joins from 30 m in only where it finds the ring): the face-on bulkhead
     // leaves the lateral position weakly observed, 1-3 cm.
     EXPECT_LT(e.port_position_error_m.norm(), 0.05) << "frame " << k;
-    if (k >= 10) {  // the model has the arrays from the ninth fitted frame on
+    if (k >= 10) {  // the model has the arrays from the third fitted frame on (first_window)
       sum_sq_deg += std::pow(e.attitude_error_angle_rad / kDeg, 2);
       ++counted;
     }
@@ -179,6 +182,14 @@ TEST(PanelOptionsValidation, NamesTheParameter) {
     FAIL() << "an even window was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("panels/window = 4"), std::string::npos) << e.what();
+  }
+  options.window = 9;
+  options.first_window = 11;
+  try {
+    validate(options);
+    FAIL() << "a first window wider than the window was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("panels/first_window = 11"), std::string::npos) << e.what();
   }
   PoseConfig iss;
   iss.panels.enabled = true;  // the ISS's arrays turn on ten joints

@@ -53,6 +53,13 @@ struct IcpOptions {
   // (deg; a prior in the normal equations): where the scan barely observes it (a near-symmetric docking
   // adapter filling the view, Hubble end-on) it no longer wanders on noise. 0: no prior.
   double boresight_prior_deg = 0.2;
+  // Acquiring, from the second frame on (the prediction is then the last acquisition estimate): a barely
+  // observed boresight rotation that the frame's own alignment leaves within this of the prediction's
+  // (deg) is aligned again with a prior at the prediction of twice boresight_prior_deg; beyond it (the gross
+  // error of a first frame from a coarse prior) the frame's own stands. Hubble from 50 m with its arrays
+  // edge-on: each acquisition frame alone measured the roll 0.02-0.86 deg off (the masts alone, sub-pixel
+  // there), so its 30-50 m RMS exceeded 0.1 deg in 4 of 24 runs. 0: off.
+  double acquisition_boresight_gate_deg = 2.0;
   // Tracking: the silhouette gate and the crop take a visibility prediction (with its grid of visible points)
   // made at a pose that moves every visible model point less than this many pixels from where the frame's
   // prediction puts it (a fraction of the prediction's 4 px cells), e.g. the frame before's: in the closed
@@ -140,8 +147,9 @@ class IcpTracker : public PoseMethod {
   };
   // Uses every stride-th scan point. tracking: from a prediction (T_start): scan points left unmatched are
   // not searched again, and a barely observed boresight rotation is held near T_start (boresight_prior_deg).
+  // Not tracking, with T_boresight_prior: such a rotation is held near it with twice that.
   Alignment align(const Eigen::Isometry3d& T_start, double gate_m, int max_iterations, bool tracking,
-                  int stride);
+                  int stride, const Eigen::Isometry3d* T_boresight_prior = nullptr);
   Alignment acquire(const Eigen::Isometry3d& T_prior);
   // Of the hypotheses, each aligned for search_iterations, the one that explains most scan points.
   Alignment bestOf(const std::vector<Eigen::Isometry3d>& hypotheses, double gate_m);

@@ -44,6 +44,11 @@ struct PanelOptions {
   // the model: 20-30 m 0.056 -> 0.068 deg).
   double min_incidence_deg = 6.0;
   int window = 9;  // the panels' angle is the median of the last window frames' fits
+  // ... but a model without panels takes them at the median of this many (odd, <= window): from 50 m in
+  // the arrays then join the model during Hubble's acquisition, not after it (approach datasets, arrays at
+  // 30 deg, 30-50 m attitude RMS 0.020-0.120 -> 0.019-0.040 deg with 3 instead of 9). One fit alone let a
+  // poor pose's fit into the model (3 of 24 runs LOST 1-3 frames).
+  int first_window = 3;
   // The model is rebuilt with the panels at that median when it differs from the model's angle by more
   // than this: a model panel 2 deg off tilted Hubble's estimate 0.15-0.4 deg (a rotation about the mast
   // axis is a pitch of the whole body to ICP).
@@ -68,9 +73,9 @@ bool fitPanelAngle(const PanelJoint& joint, const OrganizedCloud& cloud,
                    const Eigen::Isometry3d& T_lidar_target, const PanelOptions& options, PanelFit* fit);
 
 // Keeps the reference model's panels at the angle the scans measure: one fit per estimated frame, the median
-// of the last window, and a rebuilt model when the median moves (PanelOptions). Until the first median the
-// model has no panels (the rigid structure alone), and it returns to that after a window of frames in a
-// row whose fits found the panels edge-on (they turned).
+// of the last window (of first_window for the first), and a rebuilt model when the median moves
+// (PanelOptions). Until the first median the model has no panels (the rigid structure alone), and it returns
+// to that after a window of frames in a row whose fits found the panels edge-on (they turned).
 class PanelTracker {
  public:
   using ModelBuilder = std::function<std::shared_ptr<const ReferenceModel>(double angle_rad)>;
