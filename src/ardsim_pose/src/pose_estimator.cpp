@@ -116,8 +116,19 @@ Eigen::Isometry3d PoseEstimator::predict(double stamp_s) const {
 void PoseEstimator::updateVelocity(const PoseResult& result, double stamp_s) {
   const Eigen::Isometry3d& T = result.T_lidar_target;
   const double dt = stamp_s - last_good_stamp_s;
-  // The jumps of an acquisition are no motion: its estimates reset the velocity.
-  if (!have_good_ || result.acquiring || dt <= 0.0 || dt > options_.max_prediction_gap_s) {
+  const bool valid_pair = have_good_ && dt > 0.0 && dt <= options_.max_prediction_gap_s;
+  // The estimate that ends an acquisition agreed with the acquisition estimate before it, or with the motion
+  // of the two before: from that pair the linear velocity (the angular one from the next TRACKING pair).
+  // Without it, at the approach datasets' 0.5 m a frame, Hubble's first tracking frames started 0.5 m off.
+  if (valid_pair && result.acquiring && last_good_acquiring_ && result.status == EstimateStatus::kTracking) {
+    velocity_mps_ = (T.translation() - last_good_.translation()) / dt;
+    angular_velocity_radps_.setZero();
+    velocity_valid_ = true;
+    angular_velocity_unlearnt_ = true;
+    return;
+  }
+  // The jumps of an acquisition are no motion: its other estimates reset the velocity.
+  if (!valid_pair || result.acquiring) {
     velocity_valid_ = false;
     angular_velocity_unlearnt_ = false;
     return;

@@ -165,6 +165,26 @@ TEST(PoseEstimatorPrediction, TrackingAfterOnlyDegradedLearnsTheLinearVelocity) 
   EXPECT_LT(angleDeg(predictions.at(7), MotionScript::truth(7)), 1e-6);
 }
 
+TEST(PoseEstimatorPrediction, TheEstimateEndingAnAcquisitionGivesTheLinearVelocity) {
+  // Frames 0-2 acquiring (DEGRADED), frame 3 confirms it (TRACKING, from the acquisition): it agreed with the
+  // acquisition estimate before, so that pair is motion. Before session 17 frame 4 was predicted without any
+  // velocity, 0.5 m behind (Hubble's approach datasets: its first tracking frames "not converged", 0.14-0.17
+  // deg off).
+  using Step = MotionScript::Step;
+  std::map<int, Step> steps;
+  for (int frame = 0; frame < 3; ++frame) steps[frame] = Step{EstimateStatus::kDegraded, true, true};
+  steps[3] = Step{EstimateStatus::kTracking, true, true};
+  const std::map<int, Eigen::Isometry3d> predictions = predictionsOver(steps, 6);
+  auto position_error = [&](int frame) {
+    return (predictions.at(frame).translation() - MotionScript::truth(frame).translation()).norm();
+  };
+  EXPECT_NEAR(position_error(3), 0.5, 1e-9);  // acquisition estimates are no motion
+  EXPECT_LT(position_error(4), 1e-9);
+  EXPECT_NEAR(angleDeg(predictions.at(4), MotionScript::truth(3)), 0.0, 1e-6);  // the angular one not yet
+  EXPECT_LT(position_error(5), 1e-9);
+  EXPECT_LT(angleDeg(predictions.at(5), MotionScript::truth(5)), 1e-6);
+}
+
 TEST(PoseEstimatorPrediction, AnUnobservedBoresightRotationIsNoMotion) {
   using Step = MotionScript::Step;
   std::map<int, Step> steps;
