@@ -60,11 +60,14 @@ class LidarLockstepTest(unittest.TestCase):
 
     def step(self, seconds, orientation, chaser_orientation=None):
         stamp = rospy.Time.from_sec(seconds)
+        # Counted before publishing: counted after, a frame that arrived in between (this thread descheduled on a
+        # loaded machine) made it wait for one more that never comes (a 60 s timeout in a fresh-clone CI run).
+        with self.lock:
+            count = len(self.received['points']) + 1
         self.clock.publish(Clock(clock=stamp))
         chaser_position = tuple(t + o for t, o in zip(TARGET_ECI, CHASER_OFFSET))
         self.target.publish(odometry(stamp, 'target', TARGET_ECI, (0.0, 0.0, 0.0, 1.0)))
         self.chaser.publish(odometry(stamp, 'chaser', chaser_position, chaser_orientation or orientation))
-        count = len(self.received['points']) + 1
         self.wait_for(lambda: all(len(v) >= count for v in self.received.values()), 'the frame at t = %g' % seconds)
         return self.received['points'][-1], self.received['range'][-1], self.received['info'][-1]
 
