@@ -116,6 +116,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "estimator/max_prediction_gap_s", &c.estimator.max_prediction_gap_s);
   read(nh, "estimator/composite_min_port_range_m", &c.estimator.composite_min_port_range_m);
   read(nh, "estimator/composite_max_port_range_m", &c.estimator.composite_max_port_range_m);
+  read(nh, "estimator/composite_icp_roll_max_sigma_deg", &c.estimator.composite_icp_roll_max_sigma_deg);
   close_range::ModeManagerOptions& m = c.mode;
   read(nh, "mode/close_enter_range_m", &m.close_enter_range_m);
   read(nh, "mode/close_enter_fill", &m.close_enter_fill);

@@ -54,6 +54,11 @@ void validate(const EstimatorOptions& o) {
     throw std::invalid_argument(
         "estimator/composite_max_port_range_m = " + std::to_string(o.composite_max_port_range_m) +
         " is out of range: > composite_min_port_range_m .. 1000 (both 0: off)");
+  if (!(std::isfinite(o.composite_icp_roll_max_sigma_deg) && o.composite_icp_roll_max_sigma_deg >= 0.0 &&
+        o.composite_icp_roll_max_sigma_deg <= 180.0))
+    throw std::invalid_argument(
+        "estimator/composite_icp_roll_max_sigma_deg = " + std::to_string(o.composite_icp_roll_max_sigma_deg) +
+        " is out of range: 0 .. 180");
 }
 
 PoseEstimator::PoseEstimator(const EstimatorOptions& options, Methods methods,
@@ -82,8 +87,12 @@ void PoseEstimator::compose(const PoseResult& icp, const PoseResult& ring, PoseR
   // result's. Then the target moves so that its port lies where the ring put it.
   const Eigen::Vector3d turn =
       rotationVector(icp.T_lidar_target.linear() * result->T_lidar_target.linear().transpose());
-  const Eigen::Matrix3d R =
-      rotationOf(Eigen::Vector3d(turn.x(), turn.y(), 0.0)) * result->T_lidar_target.linear();
+  // ... unless ICP measured it well (EstimatorOptions::composite_icp_roll_max_sigma_deg).
+  const bool icp_roll =
+      icp.status == EstimateStatus::kTracking &&
+      std::sqrt(icp.covariance(5, 5)) * 180.0 / M_PI < options_.composite_icp_roll_max_sigma_deg;
+  const Eigen::Matrix3d R = rotationOf(Eigen::Vector3d(turn.x(), turn.y(), icp_roll ? turn.z() : 0.0)) *
+                            result->T_lidar_target.linear();
   const Eigen::Vector3d port_m = ring.T_lidar_target * T_target_port_.translation();
   result->T_lidar_target.linear() = R;
   result->T_lidar_target.translation() = port_m - R * T_target_port_.translation();

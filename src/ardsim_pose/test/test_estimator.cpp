@@ -268,11 +268,14 @@ class FixedPoseMethod : public PoseMethod {
     const int frame = frameAt(cloud.stamp_s);
     result.status = status.count(frame) ? status.at(frame) : EstimateStatus::kTracking;
     result.T_lidar_target = T_;
+    const double sigma_rad = sigma_deg * M_PI / 180.0;
+    result.covariance = Eigen::Matrix<double, 6, 6>::Identity() * sigma_rad * sigma_rad;
     return result;
   }
   void reset() override {}
   std::map<int, EstimateStatus> status;
   int calls = 0;
+  double sigma_deg = 1.0;  // of every part of the pose (as m or deg): a roll the composite leaves alone
 
  private:
   Eigen::Isometry3d T_;
@@ -351,6 +354,43 @@ TEST(PoseEstimatorComposite, PortFromTheRingTiltFromIcpRollFromTheSelected) {
   EXPECT_GT((T_icp * portTarget().translation() - ring_port).norm(), 0.02);
 }
 
+// Hubble with its arrays in ICP's model and in view: ICP measures the roll (sigma ~0.004 deg), the ring
+// method does not; the composite then takes it from a TRACKING ICP, whichever method is selected.
+TEST(PoseEstimatorComposite, RollFromIcpWhereIcpMeasuresItWell) {
+  const Eigen::Isometry3d T_icp = offTruth(turnDeg(0.02, -0.03, 0.4), Eigen::Vector3d(0.02, -0.015, 0.01));
+  const Eigen::Isometry3d T_ring = offTruth(turnDeg(0.12, 0.09, -0.2), Eigen::Vector3d(0.001, 0.0, -0.001));
+  auto icp = std::make_unique<FixedPoseMethod>(T_icp);
+  icp->sigma_deg = 0.004;
+  icp->status[1] = EstimateStatus::kDegraded;
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::move(icp);
+  methods[EstimateMethod::kRing] = std::make_unique<FixedPoseMethod>(T_ring);
+  EstimatorOptions options;
+  options.composite_min_port_range_m = 10.0;
+  options.composite_max_port_range_m = 30.0;
+  ASSERT_GT(options.composite_icp_roll_max_sigma_deg, 0.004);
+  PoseEstimator estimator(options, std::move(methods),
+                          std::make_unique<FixedMethodSelector>(EstimateMethod::kRing), portTarget());
+  estimator.setPrior(compositeTruth());
+  OrganizedCloud cloud;
+  for (int frame = 0; frame < 2; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    cloud.stamp_s = kFramePeriodS * frame;
+    const Eigen::Isometry3d T = estimator.process(cloud).result.T_lidar_target;
+    EXPECT_LT((T * portTarget().translation() - T_ring * portTarget().translation()).norm(), 1e-9);
+    const Eigen::Vector3d from_icp_deg =
+        rotationVectorOf(T.linear() * T_icp.linear().transpose()) * 180 / M_PI;
+    const Eigen::Vector3d from_ring_deg =
+        rotationVectorOf(T.linear() * T_ring.linear().transpose()) * 180 / M_PI;
+    if (frame == 0) {
+      EXPECT_LT(from_icp_deg.norm(), 1e-9);  // the whole attitude ICP's
+    } else {
+      EXPECT_LT(from_icp_deg.head<2>().norm(), 2e-3);  // ICP DEGRADED: its tilt, the ring's roll
+      EXPECT_LT(std::abs(from_ring_deg.z()), 1e-9);
+    }
+  }
+}
+
 TEST(PoseEstimatorComposite, OutsideItsBandTheSelectedMethodAlone) {
   auto icp =
       std::make_unique<FixedPoseMethod>(offTruth(turnDeg(0.02, -0.03, 0.4), Eigen::Vector3d(0.02, 0, 0)));
@@ -383,6 +423,16 @@ TEST(PoseEstimatorComposite, BadBandOrMissingMethodIsRefused) {
   }
   options.composite_max_port_range_m = 40.0;
   EXPECT_NO_THROW(validate(options));
+  options.composite_icp_roll_max_sigma_deg = -0.1;
+  try {
+    validate(options);
+    FAIL() << "a negative roll sigma was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("estimator/composite_icp_roll_max_sigma_deg = -0.1"),
+              std::string::npos)
+        << e.what();
+  }
+  options.composite_icp_roll_max_sigma_deg = 0.01;
   PoseEstimator::Methods methods;
   methods[EstimateMethod::kIcp] = std::make_unique<ScriptedMethod>();
   EXPECT_THROW(
