@@ -123,6 +123,8 @@ class PoseInterfaceTest(unittest.TestCase):
                  ('_mode/close_method:=laser', "mode/close_method = 'laser'"),
                  ('_mode/close_exit_range_m:=5.0', 'mode/close_exit_range_m = 5'),
                  ('_estimator/composite_max_port_range_m:=-5.0', 'estimator/composite_max_port_range_m = -5'),
+                 ('_estimator/composite_icp_roll_max_sigma_deg:=-1.0',
+                  'estimator/composite_icp_roll_max_sigma_deg = -1'),
                  ('_icp/acquisition_boresight_gate_deg:=-1.0', 'icp/acquisition_boresight_gate_deg = -1'),
                  ('_panels/window:=4', 'panels/window = 4'),
                  ('_panels/first_window:=2', 'panels/first_window = 2'),
