@@ -245,10 +245,15 @@ TEST_F(RenderedIcp, WeakDirectionFromAGuessOffAcrossTheLineOfSight) {
   }
 }
 
-TEST(HubbleEndOn, APredictionOffAcrossTheBoresightIsCorrected) {
+PoseConfig hubbleDefaults() {
   PoseConfig config;
   config.target = TargetKind::kHubble;
   applyTargetDefaults(&config);
+  return config;
+}
+
+TEST(HubbleEndOn, APredictionOffAcrossTheBoresightIsCorrected) {
+  const PoseConfig config = hubbleDefaults();
   const std::shared_ptr<const ReferenceModel> model = buildReferenceModel(TargetKind::kHubble, config.model);
   ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
   simulator.setTarget(ardsim_description::buildHubble());
@@ -329,6 +334,33 @@ TEST(IssCloseApproach, BoresightRotationHeldNearThePrediction) {
   EXPECT_LT(worst_deg, 0.2);  // measured 0.07 deg
 }
 
+// Hubble (its arrays edge-on) along its docking axis, rendered with noise, through the estimator with
+// Hubble's defaults from the first frame's truth, 0.1 s a frame.
+class HubbleAlongItsAxis {
+ public:
+  explicit HubbleAlongItsAxis(std::uint64_t simulator_seed)
+      : simulator_(config_.sensor, ardsim_lidar::NoiseOptions{}, simulator_seed) {
+    simulator_.setTarget(ardsim_description::buildHubble());
+  }
+  const PoseConfig& config() const { return config_; }
+  // Frame k (its noise seeded by k) with the port port_distance_m out: the estimate, and its error.
+  EstimatorOutput frame(int k, double port_distance_m, PoseErrorValue* error) {
+    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, port_distance_m);
+    if (k == 0) estimator_->setPrior(truth);
+    simulator_.simulate(truth, static_cast<std::uint64_t>(k), &rendered_);
+    const EstimatorOutput out = estimator_->process(fromLidarFrame(rendered_, simulator_.rays(), 0.1 * k));
+    *error =
+        poseError(out.result.T_lidar_target, truth, ardsim_description::T_target_port(TargetKind::kHubble));
+    return out;
+  }
+
+ private:
+  PoseConfig config_ = hubbleDefaults();
+  ardsim_lidar::LidarSimulator simulator_;
+  std::unique_ptr<PoseEstimator> estimator_ = makeEstimator(config_);
+  ardsim_lidar::LidarFrame rendered_;
+};
+
 // Hubble end-on from 40 to 30 m, 0.5 m a frame (as approach_poses --target hubble makes them), tracked from
 // the truth: the roll about Hubble's axis is barely observed. Left to wander (10-20 deg a frame) it took
 // frames to LOST ("diverged") and kept the rest DEGRADED, in acquisition at ~100 ms each. Checked directly:
@@ -339,27 +371,17 @@ TEST(IssCloseApproach, BoresightRotationHeldNearThePrediction) {
 // 91-frame approach datasets 5000 points give more TRACKING frames than 2500, 58-67 against 48-57, and
 // hubble_hold 1526 against 1323 beyond 30 m.)
 TEST(HubbleApproach, TracksWithoutLosingAFrame) {
-  PoseConfig config;
-  config.target = TargetKind::kHubble;
-  applyTargetDefaults(&config);
-  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 1);
-  simulator.setTarget(ardsim_description::buildHubble());
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
-  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
-  ardsim_lidar::LidarFrame frame;
+  HubbleAlongItsAxis hubble(1);
   double attitude_max_deg = 0.0;
   int tracked_from = -1;  // the first frame past the acquisition
   for (int k = 0; k < 21; ++k) {
-    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, 39.0 - 0.5 * k);
-    if (k == 0) estimator->setPrior(truth);
-    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
-    const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
+    PoseErrorValue e;
+    const EstimatorOutput out = hubble.frame(k, 39.0 - 0.5 * k, &e);
     ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
     if (!out.result.acquiring && tracked_from < 0) tracked_from = k;
     if (tracked_from >= 0) {
       EXPECT_FALSE(out.result.acquiring) << "frame " << k << " back in acquisition: " << out.result.reason;
     }
-    const PoseErrorValue e = poseError(out.result.T_lidar_target, truth, T_target_port);
     EXPECT_LT(e.port_position_error_m.norm(), 0.1) << "frame " << k;
     attitude_max_deg = std::max(attitude_max_deg, e.attitude_error_angle_rad * 180.0 / M_PI);
   }
@@ -374,22 +396,12 @@ TEST(HubbleApproach, TracksWithoutLosingAFrame) {
 // frames. From the second acquisition frame on a barely observed roll near the prediction's is held near it
 // (icp/acquisition_boresight_gate_deg).
 TEST(HubbleAcquisition, BarelyObservedRollHeldNearThePreviousFrame) {
-  PoseConfig config;
-  config.target = TargetKind::kHubble;
-  applyTargetDefaults(&config);
-  ASSERT_GT(config.icp.acquisition_boresight_gate_deg, 0.0);
-  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 4);
-  simulator.setTarget(ardsim_description::buildHubble());
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
-  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
-  ardsim_lidar::LidarFrame frame;
+  HubbleAlongItsAxis hubble(4);
+  ASSERT_GT(hubble.config().icp.acquisition_boresight_gate_deg, 0.0);
   for (int k = 0; k < 10; ++k) {
-    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, 49.0 - 0.5 * k);
-    if (k == 0) estimator->setPrior(truth);
-    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
-    const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
+    PoseErrorValue e;
+    const EstimatorOutput out = hubble.frame(k, 49.0 - 0.5 * k, &e);
     ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    const PoseErrorValue e = poseError(out.result.T_lidar_target, truth, T_target_port);
     EXPECT_LT(e.attitude_error_angle_rad * 180.0 / M_PI, 0.3) << "frame " << k << ": " << out.result.reason;
     EXPECT_LT(e.port_position_error_m.norm(), 0.1) << "frame " << k;
   }
