@@ -97,6 +97,9 @@ void validate(const IcpOptions& o) {
   requireOption(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
       "icp/boresight_prior_deg", o.boresight_prior_deg, "0 .. 180");
+  requireOption(std::isfinite(o.boresight_prior_max_information) &&
+                    o.boresight_prior_max_information >= 0.0 && o.boresight_prior_max_information <= 1.0,
+                "icp/boresight_prior_max_information", o.boresight_prior_max_information, "0 .. 1");
   requireOption(std::isfinite(o.acquisition_boresight_gate_deg) && o.acquisition_boresight_gate_deg >= 0.0 &&
                     o.acquisition_boresight_gate_deg <= 180.0,
                 "icp/acquisition_boresight_gate_deg", o.acquisition_boresight_gate_deg, "0 .. 180");
@@ -586,7 +589,8 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       Eigen::Matrix<double, 6, 6> H_solve = a.H;
       Eigen::Matrix<double, 6, 1> g_solve = g;
       const Eigen::Isometry3d* T_prior = tracking ? &T_start : T_boresight_prior;
-      if (T_prior != nullptr && options_.boresight_prior_deg > 0.0 && !boresight_well_observed) {
+      if (T_prior != nullptr && options_.boresight_prior_deg > 0.0 &&
+          boresight_information < options_.boresight_prior_max_information) {
         const double prior_rad = (tracking ? 1.0 : 2.0) * options_.boresight_prior_deg * M_PI / 180.0;
         const double information = sigma * sigma / (prior_rad * prior_rad);
         const Eigen::AngleAxisd turn(T.linear() * T_prior->linear().transpose());

@@ -53,6 +53,11 @@ struct IcpOptions {
   // (deg; a prior in the normal equations): where the scan barely observes it (a near-symmetric docking
   // adapter filling the view, Hubble end-on) it no longer wanders on noise. 0: no prior.
   double boresight_prior_deg = 0.2;
+  // ... where the scan's information about that rotation (with the other five free, against the largest,
+  // lever-scaled) is below this; above it the rotation is the scan's alone. By target: 0.01 (the ISS), 0.03
+  // (Hubble: on its masts a frame judged to observe its roll at 0.01-0.03 jumped 0.6 deg in one frame and
+  // kept it for a second in hubble_hold, while its covariance said 0.05 deg).
+  double boresight_prior_max_information = 0.01;
   // Acquiring, from the second frame on (the prediction is then the last acquisition estimate): a barely
   // observed boresight rotation that the frame's own alignment leaves within this of the prediction's
   // (deg) is aligned again with a prior at the prediction of twice boresight_prior_deg; beyond it (the gross
