@@ -21,7 +21,14 @@ def medians(paths):
                     "time_unit", "repetition_index"}}
                 scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b["time_unit"]]
                 rows.append((b["run_name"], b["real_time"] * scale, b["cpu_time"] * scale, counters))
-    return rows
+    # In the order the programs define them (family, then instance), not the order run: repetitions may be
+    # interleaved at random.
+    order = {}
+    for path in paths:
+        with open(path) as f:
+            for b in json.load(f)["benchmarks"]:
+                order.setdefault(b["run_name"], (path, b["family_index"], b["per_family_instance_index"]))
+    return sorted(rows, key=lambda row: order[row[0]])
 
 
 def main(paths):
