@@ -20,8 +20,11 @@ namespace {
 constexpr const char* kUsage =
     "usage: evaluate_dataset --dataset DIR [--method icp|auto|ring|pyramid] [--init truth|perturbed] [--seed "
     "N]\n"
-    "                        [--target iss|hubble] [--frame-period-s S] [--median-filter on|off]\n"
-    "Runs the estimator over DIR/frame_*.pcd in the order of DIR/truth.csv; writes DIR/estimates.csv.\n"
+    "                        [--target iss|hubble] [--frame-period-s S] [--median-filter on|off] [--out "
+    "CSV]\n"
+    "Runs the estimator over DIR/frame_*.pcd in the order of DIR/truth.csv; writes DIR/estimates.csv (or "
+    "CSV:\n"
+    "runs of several configurations over one dataset at once then keep their own).\n"
     "--init truth: the first frame starts from its truth; perturbed (default): from the coarse prior\n"
     "(truth turned 10 deg about the port, port range 10 % off, 2 m lateral; directions seeded by --seed).\n"
     "Prints per range band (lidar to port) the position error of the port and the attitude error: the whole\n"
@@ -29,6 +32,7 @@ constexpr const char* kUsage =
 
 struct Arguments {
   std::string dataset;
+  std::string out;  // the estimates' CSV; empty: DIR/estimates.csv
   std::string init = "perturbed";
   std::uint64_t seed = 1;
   double frame_period_s = 0.1;
@@ -73,11 +77,14 @@ Arguments parseArguments(int argc, char** argv) {
         throw std::invalid_argument("--frame-period-s '" + value + "' is not a number > 0");
     } else if (flag == "--median-filter") {
       a.config.estimator.median_filter = onOff(flag, value) == "on";
+    } else if (flag == "--out") {
+      a.out = value;
     } else {
       throw std::invalid_argument("unknown option " + flag);
     }
   }
   if (a.dataset.empty()) throw std::invalid_argument("--dataset is required");
+  if (a.out.empty()) a.out = a.dataset + "/estimates.csv";
   ardsim_pose::applyTargetDefaults(&a.config);
   return a;
 }
@@ -129,8 +136,8 @@ int run(int argc, char** argv) {
   estimator->setPrior(args.init == "truth" ? first
                                            : ardsim_pose::perturbPrior(first, T_target_port, {}, args.seed));
 
-  std::ofstream csv(args.dataset + "/estimates.csv");
-  if (!csv) throw std::runtime_error("cannot write " + args.dataset + "/estimates.csv");
+  std::ofstream csv(args.out);
+  if (!csv) throw std::runtime_error("cannot write " + args.out);
   csv << "frame,stamp_s,status,x,y,z,qx,qy,qz,qw,range_m,pos_err_m,att_err_deg,fit_rms_m,inlier_fraction,"
          "points_used,iterations,ms,reason\n";
   csv.precision(10);

@@ -2,6 +2,8 @@
 // frames at 100, 30 and 10 m, initial estimate = truth) must reproduce the stored estimates
 // (expected_estimates.csv, written by evaluate_dataset) within 1 mm and 0.01 deg with the same status, and
 // meet the accuracy goals against the truth. Regenerate with test/golden/regenerate.sh (see README).
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -92,6 +94,28 @@ TEST_P(Golden, ReproducesTheStoredEstimatesAndMeetsTheGoals) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Ranges, Golden, ::testing::Values(100, 30, 10));
+
+// The tool itself, with --out: its estimates go there (the same as the stored ones), none into the dataset.
+TEST(EvaluateDataset, WritesItsEstimatesWhereAsked) {
+  const std::string directory = std::string(ARDSIM_POSE_GOLDEN_DIR) + "/iss_30";
+  const std::string out = ::testing::TempDir() + "/evaluate_dataset_out.csv";
+  std::remove(out.c_str());
+  const std::string command = std::string(ARDSIM_POSE_EVALUATE_DATASET) + " --dataset " + directory +
+                              " --init truth --out " + out + " > /dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const std::vector<ExpectedRow> written = readExpected(out);
+  const std::vector<ExpectedRow> expected = readExpected(directory + "/expected_estimates.csv");
+  ASSERT_EQ(written.size(), expected.size());
+  const Eigen::Isometry3d T_target_port =
+      ardsim_description::T_target_port(ardsim_description::TargetKind::kIss);
+  for (std::size_t k = 0; k < written.size(); ++k) {
+    EXPECT_EQ(written[k].status, expected[k].status);
+    const PoseErrorValue drift =
+        poseError(written[k].T_lidar_target, expected[k].T_lidar_target, T_target_port);
+    EXPECT_LT(drift.port_position_error_m.norm(), 0.001);
+  }
+  EXPECT_FALSE(std::ifstream(directory + "/estimates.csv").good());
+}
 
 }  // namespace
 }  // namespace ardsim_pose

@@ -25,9 +25,9 @@ for range in 100 30 10; do
       --width 128 --height 128 > /dev/null
     rm -f "$dir"/*.png "$dir/poses.csv"
   fi
-  "$bin/ardsim_pose/evaluate_dataset" --dataset "$dir" --init truth | tail -1
+  "$bin/ardsim_pose/evaluate_dataset" --dataset "$dir" --init truth --out "$dir/estimates.csv.tmp" | tail -1
   # Timings differ run to run: drop them from the expected file.
-  cut -d, -f1-17 "$dir/estimates.csv" > "$dir/expected_estimates.csv"
-  rm "$dir/estimates.csv"
+  cut -d, -f1-17 "$dir/estimates.csv.tmp" > "$dir/expected_estimates.csv"
+  rm "$dir/estimates.csv.tmp"
 done
 du -sh "$here"
