@@ -9,6 +9,8 @@ NAME = re.compile(r"^BM_(?P<subject>[A-Za-z0-9]+)_(?P<impl>[A-Za-z0-9]+)(?P<args
 
 
 def medians(paths):
+    """The median rows, in the order the programs define them (family, then instance), not the order run:
+    repetitions may be interleaved at random."""
     rows = []
     for path in paths:
         with open(path) as f:
@@ -20,15 +22,9 @@ def medians(paths):
                     "threads", "aggregate_name", "aggregate_unit", "iterations", "real_time", "cpu_time",
                     "time_unit", "repetition_index"}}
                 scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b["time_unit"]]
-                rows.append((b["run_name"], b["real_time"] * scale, b["cpu_time"] * scale, counters))
-    # In the order the programs define them (family, then instance), not the order run: repetitions may be
-    # interleaved at random.
-    order = {}
-    for path in paths:
-        with open(path) as f:
-            for b in json.load(f)["benchmarks"]:
-                order.setdefault(b["run_name"], (path, b["family_index"], b["per_family_instance_index"]))
-    return sorted(rows, key=lambda row: order[row[0]])
+                order = (path, b["family_index"], b["per_family_instance_index"])
+                rows.append((order, b["run_name"], b["real_time"] * scale, b["cpu_time"] * scale, counters))
+    return [row[1:] for row in sorted(rows, key=lambda row: row[0])]
 
 
 def main(paths):

@@ -1,6 +1,6 @@
 // evaluate_dataset: runs the pose estimator over a render_dataset directory in frame order as one tracking
-// sequence, writes DIR/estimates.csv, prints a table by range band and one summary line. See README.md.
-// Errors: one line on stderr, exit status 2.
+// sequence, writes DIR/estimates.csv (or --out CSV), prints a table by range band and one summary line. See
+// README.md. Errors: one line on stderr, exit status 2.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,13 +18,12 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: evaluate_dataset --dataset DIR [--method icp|auto|ring|pyramid] [--init truth|perturbed] [--seed "
-    "N]\n"
-    "                        [--target iss|hubble] [--frame-period-s S] [--median-filter on|off] [--out "
-    "CSV]\n"
-    "Runs the estimator over DIR/frame_*.pcd in the order of DIR/truth.csv; writes DIR/estimates.csv (or "
-    "CSV:\n"
-    "runs of several configurations over one dataset at once then keep their own).\n"
+    "usage: evaluate_dataset --dataset DIR [--method icp|auto|ring|pyramid] [--init truth|perturbed]\n"
+    "                        [--seed N] [--target iss|hubble] [--frame-period-s S] [--median-filter on|off]\n"
+    "                        [--out CSV]\n"
+    "Runs the estimator over DIR/frame_*.pcd in the order of DIR/truth.csv; writes DIR/estimates.csv, or "
+    "CSV\n"
+    "(runs of several configurations over one dataset at once then keep their own).\n"
     "--init truth: the first frame starts from its truth; perturbed (default): from the coarse prior\n"
     "(truth turned 10 deg about the port, port range 10 % off, 2 m lateral; directions seeded by --seed).\n"
     "Prints per range band (lidar to port) the position error of the port and the attitude error: the whole\n"
