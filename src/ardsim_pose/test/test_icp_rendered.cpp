@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "along_docking_axis.h"
 #include "ardsim_description/models.h"
 #include "ardsim_lidar/lidar_simulator.h"
 #include "ardsim_pose/dataset.h"
@@ -346,22 +347,15 @@ double issHandOverAttitudeRmsDeg(bool composite) {
   applyTargetDefaults(&config);
   if (!composite)
     config.estimator.composite_min_port_range_m = config.estimator.composite_max_port_range_m = 0.0;
-  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 3);
-  simulator.setTarget(ardsim_description::buildIss());
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
-  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kIss);
-  ardsim_lidar::LidarFrame frame;
+  AlongTheDockingAxis iss(config, ardsim_description::buildIss(), 3);
   double sum_sq = 0.0;
   int count = 0;
   for (int k = 0; k < 29; ++k) {
     const double port_m = 12.4 - 0.1 * k;
-    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kIss, port_m - 1.0);  // the lidar 1 m behind
-    if (k == 0) estimator->setPrior(truth);
-    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
-    const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
+    PoseErrorValue e;
+    const EstimatorOutput out = iss.frame(k, port_m - 1.0, &e);  // the lidar 1 m behind the chaser's port
     EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
     if (port_m > 11.5) continue;  // the hand-over and its blend
-    const PoseErrorValue e = poseError(out.result.T_lidar_target, truth, T_target_port);
     sum_sq += std::pow(e.attitude_error_angle_rad * 180.0 / M_PI, 2);
     ++count;
   }
@@ -375,32 +369,10 @@ TEST(IssHandOver, CompositeTakesIcpRollWhereTheRingsIsWeak) {
   EXPECT_LT(composite_deg, 0.75 * ring_deg) << ring_deg;  // measured 0.038
 }
 
-// Hubble (its arrays edge-on) along its docking axis, rendered with noise, through the estimator with
-// Hubble's defaults from the first frame's truth, 0.1 s a frame.
-class HubbleAlongItsAxis {
- public:
-  explicit HubbleAlongItsAxis(std::uint64_t simulator_seed)
-      : simulator_(config_.sensor, ardsim_lidar::NoiseOptions{}, simulator_seed) {
-    simulator_.setTarget(ardsim_description::buildHubble());
-  }
-  const PoseConfig& config() const { return config_; }
-  // Frame k (its noise seeded by k) with the port port_distance_m out: the estimate, and its error.
-  EstimatorOutput frame(int k, double port_distance_m, PoseErrorValue* error) {
-    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, port_distance_m);
-    if (k == 0) estimator_->setPrior(truth);
-    simulator_.simulate(truth, static_cast<std::uint64_t>(k), &rendered_);
-    const EstimatorOutput out = estimator_->process(fromLidarFrame(rendered_, simulator_.rays(), 0.1 * k));
-    *error =
-        poseError(out.result.T_lidar_target, truth, ardsim_description::T_target_port(TargetKind::kHubble));
-    return out;
-  }
-
- private:
-  PoseConfig config_ = hubbleDefaults();
-  ardsim_lidar::LidarSimulator simulator_;
-  std::unique_ptr<PoseEstimator> estimator_ = makeEstimator(config_);
-  ardsim_lidar::LidarFrame rendered_;
-};
+// Hubble (its arrays edge-on) along its docking axis with Hubble's defaults, 0.1 s a frame.
+AlongTheDockingAxis hubbleAlongItsAxis(std::uint64_t simulator_seed) {
+  return AlongTheDockingAxis(hubbleDefaults(), ardsim_description::buildHubble(), simulator_seed);
+}
 
 // Hubble end-on from 40 to 30 m, 0.5 m a frame (as approach_poses --target hubble makes them), tracked from
 // the truth: the roll about Hubble's axis is barely observed. Left to wander (10-20 deg a frame) it took
@@ -412,7 +384,7 @@ class HubbleAlongItsAxis {
 // 91-frame approach datasets 5000 points give more TRACKING frames than 2500, 58-67 against 48-57, and
 // hubble_hold 1526 against 1323 beyond 30 m.)
 TEST(HubbleApproach, TracksWithoutLosingAFrame) {
-  HubbleAlongItsAxis hubble(1);
+  AlongTheDockingAxis hubble = hubbleAlongItsAxis(1);
   double attitude_max_deg = 0.0;
   int tracked_from = -1;  // the first frame past the acquisition
   for (int k = 0; k < 21; ++k) {
@@ -437,7 +409,7 @@ TEST(HubbleApproach, TracksWithoutLosingAFrame) {
 // frames. From the second acquisition frame on a barely observed roll near the prediction's is held near it
 // (icp/acquisition_boresight_gate_deg).
 TEST(HubbleAcquisition, BarelyObservedRollHeldNearThePreviousFrame) {
-  HubbleAlongItsAxis hubble(4);
+  AlongTheDockingAxis hubble = hubbleAlongItsAxis(4);
   ASSERT_GT(hubble.config().icp.acquisition_boresight_gate_deg, 0.0);
   for (int k = 0; k < 10; ++k) {
     PoseErrorValue e;

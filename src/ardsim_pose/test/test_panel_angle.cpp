@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "along_docking_axis.h"
 #include "ardsim_description/models.h"
 #include "ardsim_lidar/lidar_simulator.h"
 #include "ardsim_pose/dataset.h"
@@ -148,22 +149,15 @@ TEST(PanelTracker, ArraysTurnedNearlyEdgeOnLeaveTheModel) {
 TEST(PanelTracker, ArraysTurnedFromTheModelAreMeasuredAndTracked) {
   const PoseConfig config = hubbleConfig();
   ASSERT_TRUE(config.panels.enabled);
-  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 2);
-  ardsim_description::HubbleOptions hubble;
-  hubble.solar_array_deg = 30.0;
-  simulator.setTarget(ardsim_description::buildHubble(hubble));
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
-  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
-  ardsim_lidar::LidarFrame frame;
+  ardsim_description::HubbleOptions turned;
+  turned.solar_array_deg = 30.0;
+  AlongTheDockingAxis hubble(config, ardsim_description::buildHubble(turned), 2, 0.5);
   double sum_sq_deg = 0.0;
   int counted = 0;
   for (int k = 0; k < 17; ++k) {
-    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, 30.0 - 0.5 * k);
-    if (k == 0) estimator->setPrior(truth);
-    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
-    const EstimatorOutput out = estimator->process(fromLidarFrame(frame, simulator.rays(), 0.5 * k));
+    PoseErrorValue e;
+    const EstimatorOutput out = hubble.frame(k, 30.0 - 0.5 * k, &e);
     ASSERT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    const PoseErrorValue e = poseError(out.result.T_lidar_target, truth, T_target_port);
     // ICP alone (the ring's position joins from 30 m in only where it finds the ring): the face-on bulkhead
     // leaves the lateral position weakly observed, 1-3 cm.
     EXPECT_LT(e.port_position_error_m.norm(), 0.05) << "frame " << k;
