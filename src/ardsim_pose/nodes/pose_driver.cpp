@@ -78,6 +78,8 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/boresight_prior_deg", &i.boresight_prior_deg);
   read(nh, "icp/boresight_prior_max_information", &i.boresight_prior_max_information);
+  read(nh, "icp/boresight_prior_frames", &i.boresight_prior_frames);
+  read(nh, "icp/boresight_prior_min_deg", &i.boresight_prior_min_deg);
   read(nh, "icp/acquisition_boresight_gate_deg", &i.acquisition_boresight_gate_deg);
   read(nh, "icp/crop_reuse_px", &i.crop_reuse_px);
   read(nh, "icp/converged_translation_m", &i.converged_translation_m);

@@ -58,6 +58,12 @@ void applyTargetDefaults(PoseConfig* config) {
   // 0.060 / 0.039 -> 0.030 / 0.034 deg, worst frame 0.58 / 0.40 -> 0.14 / 0.23; approach datasets 20-30 m
   // 0.012-0.046 -> 0.012-0.039 deg, 30-50 m 0.018-0.053 -> 0.019-0.045.
   config->icp.boresight_prior_max_information = hubble ? 0.03 : defaults.icp.boresight_prior_max_information;
+  // ... and tightens to 0.02 deg once tracked for 36 frames (IcpOptions::boresight_prior_frames): hubble_hold
+  // over lidar seeds 2, 11, 23, 37, 51, ICP 30-50 m attitude RMS 0.030-0.082 -> 0.018-0.026 deg, worst frame
+  // 0.14-0.52 -> 0.050-0.17; the approach datasets' bands as before (at 0.5 m a frame they leave 30-50 m
+  // first).
+  config->icp.boresight_prior_frames = hubble ? 36 : defaults.icp.boresight_prior_frames;
+  config->icp.boresight_prior_min_deg = hubble ? 0.02 : defaults.icp.boresight_prior_min_deg;
   // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43
   // deg RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
   // fills a quarter of the view): the close-range method takes over there (10-20 m: 0.3-0.6 cm, 0.05-0.10

@@ -100,6 +100,12 @@ void validate(const IcpOptions& o) {
   requireOption(std::isfinite(o.boresight_prior_max_information) &&
                     o.boresight_prior_max_information >= 0.0 && o.boresight_prior_max_information <= 1.0,
                 "icp/boresight_prior_max_information", o.boresight_prior_max_information, "0 .. 1");
+  requireOption(o.boresight_prior_frames >= 0 && o.boresight_prior_frames <= 1000000,
+                "icp/boresight_prior_frames", o.boresight_prior_frames, "0 .. 1000000");
+  requireOption(std::isfinite(o.boresight_prior_min_deg) && o.boresight_prior_min_deg >= 0.0 &&
+                    (o.boresight_prior_frames == 0 || o.boresight_prior_min_deg <= o.boresight_prior_deg),
+                "icp/boresight_prior_min_deg", o.boresight_prior_min_deg,
+                "0 .. boresight_prior_deg (with boresight_prior_frames > 0)");
   requireOption(std::isfinite(o.acquisition_boresight_gate_deg) && o.acquisition_boresight_gate_deg >= 0.0 &&
                     o.acquisition_boresight_gate_deg <= 180.0,
                 "icp/acquisition_boresight_gate_deg", o.acquisition_boresight_gate_deg, "0 .. 180");
@@ -591,7 +597,8 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       const Eigen::Isometry3d* T_prior = tracking ? &T_start : T_boresight_prior;
       if (T_prior != nullptr && options_.boresight_prior_deg > 0.0 &&
           boresight_information < options_.boresight_prior_max_information) {
-        const double prior_rad = (tracking ? 1.0 : 2.0) * options_.boresight_prior_deg * M_PI / 180.0;
+        const double prior_rad =
+            tracking ? trackingBoresightPriorRad() : 2.0 * options_.boresight_prior_deg * M_PI / 180.0;
         const double information = sigma * sigma / (prior_rad * prior_rad);
         const Eigen::AngleAxisd turn(T.linear() * T_prior->linear().transpose());
         H_solve(5, 5) += information;
@@ -683,6 +690,16 @@ IcpTracker::Alignment IcpTracker::bestOf(const std::vector<Eigen::Isometry3d>& h
   return best;
 }
 
+double IcpTracker::trackingBoresightPriorRad() const {
+  double prior_deg = options_.boresight_prior_deg;
+  if (options_.boresight_prior_frames > 0 && tracked_frames_ > options_.boresight_prior_frames) {
+    prior_deg = std::max(options_.boresight_prior_min_deg,
+                         prior_deg * std::sqrt(static_cast<double>(options_.boresight_prior_frames) /
+                                               static_cast<double>(tracked_frames_)));
+  }
+  return prior_deg * M_PI / 180.0;
+}
+
 IcpTracker::Alignment IcpTracker::acquire(const Eigen::Isometry3d& T_prior) {
   // 1. Range from the depths, then the prior, lateral offsets of it and turns about the scan's centroid, each
   // aligned briefly with the wide gate; the one that explains most scan points wins.
@@ -769,6 +786,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   const bool acquiring = acquiring_;
   result.acquiring = acquiring;
   auto lost = [&](const std::string& reason) {
+    tracked_frames_ = 0;
     result.status = EstimateStatus::kLost;
     result.reason = reason;
     result.covariance.setZero();
@@ -940,6 +958,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     acquired_.push_back({cloud.stamp_s, T});
     if (acquired_.size() > 2) acquired_.erase(acquired_.begin());
   }
+  tracked_frames_ = acquiring ? 0 : tracked_frames_ + 1;
   if (degraded.empty()) {
     result.status = EstimateStatus::kTracking;
     acquiring_ = false;

@@ -58,6 +58,14 @@ struct IcpOptions {
   // (Hubble: on its masts a frame judged to observe its roll at 0.01-0.03 jumped 0.6 deg in one frame and
   // kept it for a second in hubble_hold, while its covariance said 0.05 deg).
   double boresight_prior_max_information = 0.01;
+  // ... and once tracking for more than boresight_prior_frames frames in a row (0: never), that prior
+  // tightens as 1 / sqrt(the frames tracked), down to boresight_prior_min_deg: the held rotation is an
+  // average over them by then. By target: never (the ISS); 36 frames and 0.02 deg (Hubble: on its masts,
+  // arrays edge-on, frames at 30-50 m fit the roll 0.4-0.5 deg off for seconds on end, and the 0.05 deg prior
+  // followed; tight from the start, it held an acquisition's 1 deg error through the 0.5 m a frame approach
+  // datasets).
+  int boresight_prior_frames = 0;
+  double boresight_prior_min_deg = 0.0;
   // Acquiring, from the second frame on (the prediction is then the last acquisition estimate): a barely
   // observed boresight rotation that the frame's own alignment leaves within this of the prediction's
   // (deg) is aligned again with a prior at the prediction of twice boresight_prior_deg; beyond it (the gross
@@ -124,6 +132,7 @@ class IcpTracker : public PoseMethod {
   void reset() override {
     acquiring_ = true;
     acquired_.clear();
+    tracked_frames_ = 0;
   }
 
   bool acquiring() const { return acquiring_; }
@@ -156,6 +165,8 @@ class IcpTracker : public PoseMethod {
   Alignment align(const Eigen::Isometry3d& T_start, double gate_m, int max_iterations, bool tracking,
                   int stride, const Eigen::Isometry3d* T_boresight_prior = nullptr);
   Alignment acquire(const Eigen::Isometry3d& T_prior);
+  // The boresight prior's standard deviation this tracking frame (IcpOptions::boresight_prior_*), rad.
+  double trackingBoresightPriorRad() const;
   // Of the hypotheses, each aligned for search_iterations, the one that explains most scan points.
   Alignment bestOf(const std::vector<Eigen::Isometry3d>& hypotheses, double gate_m);
   // Every stride-th scan point within explained_distance_m of the model surface visible in visible_, at T.
@@ -235,6 +246,7 @@ class IcpTracker : public PoseMethod {
   std::array<VisibilitySlot, 2> slots_;
   int current_ = 0;
   bool acquiring_ = true;
+  int tracked_frames_ = 0;  // tracking frames in a row before this one (IcpOptions::boresight_prior_frames)
   std::vector<std::pair<double, Eigen::Isometry3d>>
       acquired_;  // (stamp s, pose) of the last acquisition frames
   double coverage_ = 0.0;
