@@ -60,8 +60,8 @@ void applyTargetDefaults(PoseConfig* config) {
   config->icp.boresight_prior_max_information = hubble ? 0.03 : defaults.icp.boresight_prior_max_information;
   // ... and tightens to 0.02 deg once tracked for 36 frames (IcpOptions::boresight_prior_frames): hubble_hold
   // over lidar seeds 2, 11, 23, 37, 51, ICP 30-50 m attitude RMS 0.030-0.082 -> 0.018-0.026 deg, worst frame
-  // 0.14-0.52 -> 0.050-0.17; the approach datasets' bands as before (at 0.5 m a frame they leave 30-50 m
-  // first).
+  // 0.14-0.52 -> 0.050-0.17; the approach datasets' bands as before (at 0.5 m a frame, 36 frames take them
+  // from 51 to 33 m).
   config->icp.boresight_prior_frames = hubble ? 36 : defaults.icp.boresight_prior_frames;
   config->icp.boresight_prior_min_deg = hubble ? 0.02 : defaults.icp.boresight_prior_min_deg;
   // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43
