@@ -29,8 +29,8 @@ def main():
     summary = {band: {'pos_rms': [], 'att_rms': [], 'pos_worst': 0.0, 'att_worst': 0.0, 'pos_ok': 0,
                       'att_ok': 0} for band in BANDS}
     lost = 0
-    print(f"{'run':28s} {'band m':7s} {'pos RMS / worst cm':>19s} {'x RMS':>6s} {'att RMS / worst deg':>20s} "
-          f"{'x RMS':>6s}")
+    print(f"{'run':28s} {'band m':7s} {'pos RMS / worst cm':>19s} {'/RMS':>6s} {'att RMS / worst deg':>20s} "
+          f"{'/RMS':>6s}")
     for path in sys.argv[1:]:
         with open(path, newline='') as f:
             rows = list(csv.DictReader(f))
