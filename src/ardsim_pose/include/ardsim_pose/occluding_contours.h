@@ -1,0 +1,86 @@
+// Sub-pixel placement of a target's occluding contours (where its surface ends against the background or
+// against structure far behind), for the directions that point-to-plane ICP leaves weak: a plane seen
+// face-on (Hubble's aft bulkhead) says nothing about sliding across it, and offsets to the nearest model
+// points place its rim only to the sampling (they carry no information within half a pixel's footprint).
+// Here each pair of neighbouring pixels across a depth edge of the scan (a return, and beside it none or one
+// much farther) says the contour crosses between their centres; the model's contour along that line at a
+// pose is the outermost of its visible points in the pixel row (or column) near the return's depth. The
+// midpoint is off by at most half a pixel, evenly either way, so hundreds of pairs place the contour far
+// better than a pixel. ROS-free.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "ardsim_lidar/sensor.h"
+#include "ardsim_pose/pose_types.h"
+#include "ardsim_pose/reference_model.h"
+
+namespace ardsim_pose {
+
+class OccludingContours {
+ public:
+  // depth_jump_m: a neighbour at least this much farther (or with no return) is across an edge; window_px:
+  // how far along the pair's line the model's contour is looked for (beyond it the pair is not used).
+  OccludingContours(const ardsim_lidar::Intrinsics& intrinsics, double depth_jump_m = 0.3, int window_px = 3);
+
+  // The edge pairs of a frame whose returns are among pixels (indices into cloud.points).
+  void extract(const OrganizedCloud& cloud, const std::vector<int>& pixels);
+  std::size_t pairs() const { return pairs_.size(); }
+
+  // The visible model points (those of patches) that project near a pair's line at T_lidar_target; the
+  // accumulation follows them while the pose moves less than a pixel or two from T_lidar_target.
+  void selectCandidates(const ReferenceModel& model, const std::vector<std::uint32_t>& patches,
+                        const Eigen::Isometry3d& T_lidar_target);
+
+  // Adds to the normal equations (H, g) of a twist (v, w) about centre, p' = p + w x (p - centre) + v, one
+  // row per pair whose model contour lies within the window: the pair's midpoint minus the model's contour
+  // along the pair's line, in metres at the contour's depth, weighted (sigma_m / the contour's sigma)^2 with
+  // sigma_px the contour's own in pixels, Tukey-weighted within limit_px. Returns the rows added.
+  int accumulate(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
+                 const Eigen::Vector3d& centre, double sigma_m, double sigma_px, double limit_px,
+                 Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
+
+  // The model's contour offset (px, positive outward) of each pair at T_lidar_target, NaN where none is
+  // found within the window (tests, diagnostics).
+  std::vector<double> residualsPx(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target);
+
+ private:
+  struct Pair {
+    int u = 0, v = 0;    // the return's pixel
+    int du = 0, dv = 0;  // towards its neighbour across the edge
+    float depth_m = 0.0f;
+  };
+  struct Found {
+    bool ok = false;
+    double offset_px = 0.0;  // the model's contour minus the pair's midpoint, along (du, dv)
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // the model's contour point, lidar frame
+  };
+  // Projects the candidates at T into their pixels' buckets.
+  void project(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target);
+  Found find(const Pair& pair) const;
+
+  ardsim_lidar::Intrinsics intrinsics_;
+  float depth_jump_m_;
+  int window_px_;
+  std::vector<Pair> pairs_;
+  std::vector<float> depth_;                  // scratch: per pixel, +inf where no return
+  std::vector<std::uint8_t> near_saturated_;  // scratch: per pixel, within the bloom of a saturated return
+  std::vector<std::int32_t> bucket_of_;       // per pixel: its bucket (pixels near a pair's line) or -1
+  int buckets_ = 0;
+  std::vector<std::uint32_t> candidates_;    // model point indices
+  std::vector<std::uint32_t> bucket_begin_;  // buckets_ + 1
+  struct Projected {
+    float u, v, z;
+    float radius_px;  // half the sample's spacing
+    std::uint32_t index;
+  };
+  std::vector<Projected> projected_;  // by bucket
+  std::vector<Projected> scratch_;
+  std::vector<std::int32_t> bucket_scratch_;
+};
+
+}  // namespace ardsim_pose
