@@ -75,6 +75,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/tukey_c", &i.tukey_c);
   read(nh, "icp/weak_direction_condition", &i.weak_direction_condition);
   read(nh, "icp/degraded_weak_slide_px", &i.degraded_weak_slide_px);
+  read(nh, "icp/contour_sigma_px", &i.contour_sigma_px);
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/boresight_prior_deg", &i.boresight_prior_deg);
   read(nh, "icp/boresight_prior_max_information", &i.boresight_prior_max_information);

@@ -54,9 +54,9 @@ struct IcpOptions {
   // (OccludingContours: pairs of pixels across a depth edge, the model's contour between their centres),
   // which place a rim to a fraction of a pixel where the offsets stop at half one, and the roll by the edges
   // of off-axis structure (Hubble's masts): the contour's standard deviation in pixels (half a pixel either
-  // way, evenly: 0.29, and the model's sampling). Hubble's approach datasets at 30-50 m: port position RMS
-  // 0.8-2.3 -> 0.13-0.20 cm, attitude 0.019-0.045 -> 0.016-0.026 deg. 0: the planes (and offsets) alone.
-  double contour_sigma_px = 0.3;
+  // way, evenly: 0.29, and the model's sampling). 0: the planes (and offsets) alone. By target: 0 (the
+  // ISS), 0.3 (Hubble; applyTargetDefaults says why).
+  double contour_sigma_px = 0.0;
   double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
   // Tracking: the rotation about the boresight is held near the prediction with this standard deviation
   // (deg; a prior in the normal equations): where the scan barely observes it (a near-symmetric docking

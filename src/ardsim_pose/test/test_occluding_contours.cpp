@@ -1,0 +1,144 @@
+// The occluding contours that ICP measures where its planes leave directions weak: the edge pairs of a frame
+// (a return beside none or one far behind, never at the image's border or in a retro-reflector's bloom),
+// and Hubble's rim placed across the boresight far better than a pixel from a pose half a footprint off,
+// where the tangential offsets carry no information.
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "along_docking_axis.h"
+#include "ardsim_description/models.h"
+#include "ardsim_lidar/lidar_simulator.h"
+#include "ardsim_pose/dataset.h"
+#include "ardsim_pose/estimator_factory.h"
+#include "ardsim_pose/occluding_contours.h"
+
+namespace ardsim_pose {
+namespace {
+
+using ardsim_description::TargetKind;
+
+ardsim_lidar::Intrinsics smallSensor() {
+  ardsim_lidar::Intrinsics intrinsics;
+  intrinsics.width = 32;
+  intrinsics.height = 32;
+  intrinsics.fx = intrinsics.fy = 100.0;
+  intrinsics.cx = intrinsics.cy = 15.5;
+  return intrinsics;
+}
+
+// A square of returns at 10 m, 10 x 10 pixels, with a step 0.2 m back (less than the jump) in its right
+// half, on an empty background.
+OrganizedCloud squareCloud(const ardsim_lidar::Intrinsics& intrinsics, std::vector<int>* pixels) {
+  OrganizedCloud cloud;
+  cloud.width = intrinsics.width;
+  cloud.height = intrinsics.height;
+  cloud.points.assign(cloud.width * cloud.height, Eigen::Vector3f::Constant(NAN));
+  cloud.intensity.assign(cloud.points.size(), 0.05f);
+  for (int v = 10; v < 20; ++v) {
+    for (int u = 10; u < 20; ++u) {
+      const float z = u < 15 ? 10.0f : 10.2f;
+      cloud.points[v * cloud.width + u] =
+          Eigen::Vector3f((u - 15.5f) * z / 100.0f, (v - 15.5f) * z / 100.0f, z);
+      pixels->push_back(v * cloud.width + u);
+    }
+  }
+  return cloud;
+}
+
+TEST(OccludingContourPairs, AcrossDepthEdgesOnly) {
+  const ardsim_lidar::Intrinsics intrinsics = smallSensor();
+  std::vector<int> pixels;
+  OrganizedCloud cloud = squareCloud(intrinsics, &pixels);
+  OccludingContours contours(intrinsics);
+  contours.extract(cloud, pixels);
+  // The square's outline: 10 pixels on each of 4 sides, the step inside it is no edge.
+  EXPECT_EQ(contours.pairs(), 40u);
+
+  // Far behind: the left half's right edge is one now (10 more pairs).
+  for (int v = 10; v < 20; ++v)
+    for (int u = 15; u < 20; ++u) cloud.points[v * cloud.width + u] *= 1.5f;
+  contours.extract(cloud, pixels);
+  EXPECT_EQ(contours.pairs(), 50u);
+
+  // A saturated return blooms: no pair within 2 pixels of it.
+  cloud.intensity[10 * cloud.width + 10] = 1.0f;
+  contours.extract(cloud, pixels);
+  EXPECT_EQ(contours.pairs(), 50u - 6u);  // corner (10, 10): 3 on the top row and 3 down the left side
+
+  // Nor where the window would leave the image: the square moved to the border.
+  std::vector<int> border;
+  OrganizedCloud edge;
+  edge.width = cloud.width;
+  edge.height = cloud.height;
+  edge.points.assign(cloud.points.size(), Eigen::Vector3f::Constant(NAN));
+  for (int v = 0; v < edge.height; ++v) {
+    for (int u = 0; u < 3; ++u) {
+      edge.points[v * edge.width + u] = Eigen::Vector3f(0.0f, 0.0f, 10.0f);
+      border.push_back(v * edge.width + u);
+    }
+  }
+  contours.extract(edge, border);
+  EXPECT_EQ(contours.pairs(), 0u);
+}
+
+// Gauss-Newton on the contours alone from T, the range held (ICP's planes measure it) and a little ridge
+// regression.
+Eigen::Isometry3d alignContours(OccludingContours* contours, const ReferenceModel& model,
+                                Eigen::Isometry3d T) {
+  for (int iteration = 0; iteration < 4; ++iteration) {
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    const Eigen::Vector3d centre = T.translation();
+    EXPECT_GT(contours->accumulate(model, T, centre, 0.01, 0.3, 3.0, &H, &g), 100);
+    H += 1e-3 * Eigen::Matrix<double, 6, 6>::Identity();
+    H(2, 2) += 1e6;
+    const Eigen::Matrix<double, 6, 1> step = H.ldlt().solve(g);
+    Eigen::Isometry3d twist = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d w = step.tail<3>();
+    if (w.norm() > 0.0) twist.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    twist.translation() = centre + step.head<3>() - twist.linear() * centre;
+    T = twist * T;
+  }
+  return T;
+}
+
+TEST(OccludingContours, PlaceHubblesRimFarBelowAPixel) {
+  PoseConfig config;
+  config.target = TargetKind::kHubble;
+  applyTargetDefaults(&config);
+  const std::shared_ptr<const ReferenceModel> model = buildReferenceModel(TargetKind::kHubble, config.model);
+  const ardsim_lidar::Intrinsics intrinsics = ardsim_lidar::intrinsicsFor(config.sensor);
+  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
+  simulator.setTarget(ardsim_description::buildHubble());
+  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
+  for (const double range_m : {45.0, 35.0, 25.0}) {
+    SCOPED_TRACE("port at " + std::to_string(range_m) + " m");
+    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, range_m);
+    ardsim_lidar::LidarFrame frame;
+    simulator.simulate(truth, 3, &frame);
+    const OrganizedCloud cloud = fromLidarFrame(frame, simulator.rays(), 0.0);
+    std::vector<int> pixels;
+    for (int i = 0; i < cloud.width * cloud.height; ++i)
+      if (cloud.points[i].allFinite()) pixels.push_back(i);
+    // Half a pixel's footprint off across the boresight, diagonally.
+    const double footprint_m = range_m / intrinsics.fx;
+    Eigen::Isometry3d start = truth;
+    start.translation() += 0.5 * footprint_m * Eigen::Vector3d(0.8, -0.6, 0.0);
+    VisibilityPredictor predictor(intrinsics, config.visibility);
+    std::vector<std::uint8_t> visible;
+    predictor.predict(*model, start, &visible);
+    OccludingContours contours(intrinsics);
+    contours.extract(cloud, pixels);
+    contours.selectCandidates(*model, predictor.visiblePatches(), start);
+    const Eigen::Isometry3d T = alignContours(&contours, *model, start);
+    const Eigen::Vector3d port_error = T * T_target_port.translation() - truth * T_target_port.translation();
+    // Across the boresight (lidar x, y): a tenth of a footprint (the start: half of one).
+    EXPECT_LT(port_error.head<2>().norm(), 0.1 * footprint_m) << port_error.transpose();
+  }
+}
+
+}  // namespace
+}  // namespace ardsim_pose
