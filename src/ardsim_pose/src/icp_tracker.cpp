@@ -352,7 +352,7 @@ bool IcpTracker::addContours(const Alignment& a, Eigen::Matrix<double, 6, 6>* H,
     T_contours_ = a.T;
   }
   constexpr double kContourLimitPx = 3.0;  // Tukey's limit: the window (beyond it no pair counts anyway)
-  return contours_.accumulate(*model_, a.T, a.centre, a.limit_m / options_.tukey_c, options_.contour_sigma_px,
+  return contours_.accumulate(a.T, a.centre, a.limit_m / options_.tukey_c, options_.contour_sigma_px,
                               kContourLimitPx, H, g) > 0;
 }
 

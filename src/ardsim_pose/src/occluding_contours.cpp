@@ -11,6 +11,11 @@ namespace {
 // ardsim_lidar's default).
 constexpr float kSaturatedIntensity = 0.99f;
 constexpr int kBloomRadiusPx = 2;
+
+// The pixel a projection falls in (pixel centres at integer coordinates); std::lround is a library call.
+int pixelOf(float coordinate) {
+  return static_cast<int>(std::floor(coordinate + 0.5f));
+}
 }  // namespace
 
 OccludingContours::OccludingContours(const ardsim_lidar::Intrinsics& intrinsics, double depth_jump_m,
@@ -83,15 +88,27 @@ void OccludingContours::selectCandidates(const ReferenceModel& model,
     for (std::uint32_t j = range.begin; j < range.end; ++j) {
       const Eigen::Vector3f X = R * model.points()[j] + t;
       if (!(X.z() > 0.0f)) continue;
-      const int u = static_cast<int>(std::lround(fx * X.x() / X.z() + cx));
-      const int v = static_cast<int>(std::lround(fy * X.y() / X.z() + cy));
+      const int u = pixelOf(fx * X.x() / X.z() + cx);
+      const int v = pixelOf(fy * X.y() / X.z() + cy);
       if (u < 0 || v < 0 || u >= w || v >= h || bucket_of_[v * w + u] < 0) continue;
       candidates_.push_back(j);
     }
   }
+  const Eigen::Index n = static_cast<Eigen::Index>(candidates_.size());
+  candidate_x_.resize(n);
+  candidate_y_.resize(n);
+  candidate_z_.resize(n);
+  candidate_radius_.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const std::uint32_t j = candidates_[k];
+    candidate_x_[k] = model.points()[j].x();
+    candidate_y_[k] = model.points()[j].y();
+    candidate_z_[k] = model.points()[j].z();
+    candidate_radius_[k] = 0.5f * model.spacing()[j];
+  }
 }
 
-void OccludingContours::project(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target) {
+void OccludingContours::project(const Eigen::Isometry3d& T_lidar_target) {
   const int w = intrinsics_.width, h = intrinsics_.height;
   const Eigen::Matrix3f R = T_lidar_target.linear().cast<float>();
   const Eigen::Vector3f t = T_lidar_target.translation().cast<float>();
@@ -100,15 +117,22 @@ void OccludingContours::project(const ReferenceModel& model, const Eigen::Isomet
   scratch_.clear();
   bucket_scratch_.clear();
   bucket_begin_.assign(buckets_ + 1, 0);
-  for (const std::uint32_t j : candidates_) {
-    const Eigen::Vector3f X = R * model.points()[j] + t;
-    if (!(X.z() > 0.0f)) continue;
-    const float u = fx * X.x() / X.z() + cx, v = fy * X.y() / X.z() + cy;
-    const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
+  largest_radius_px_ = 0.0f;
+  // The candidates' projections as array expressions (vectorized), then their buckets.
+  const Eigen::Index n = static_cast<Eigen::Index>(candidates_.size());
+  z_ = R(2, 0) * candidate_x_ + R(2, 1) * candidate_y_ + R(2, 2) * candidate_z_ + t(2);
+  u_ = (R(0, 0) * candidate_x_ + R(0, 1) * candidate_y_ + R(0, 2) * candidate_z_ + t(0)) * fx / z_ + cx;
+  v_ = (R(1, 0) * candidate_x_ + R(1, 1) * candidate_y_ + R(1, 2) * candidate_z_ + t(1)) * fy / z_ + cy;
+  const float f = std::max(fx, fy);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (!(z_[k] > 0.0f)) continue;
+    const int iu = pixelOf(u_[k]), iv = pixelOf(v_[k]);
     if (iu < 0 || iv < 0 || iu >= w || iv >= h) continue;
     const std::int32_t b = bucket_of_[iv * w + iu];
     if (b < 0) continue;
-    scratch_.push_back({u, v, X.z(), 0.5f * model.spacing()[j] * std::max(fx, fy) / X.z(), j});
+    const float radius_px = candidate_radius_[k] * f / z_[k];
+    largest_radius_px_ = std::max(largest_radius_px_, radius_px);
+    scratch_.push_back({u_[k], v_[k], z_[k], radius_px});
     bucket_scratch_.push_back(b);
     ++bucket_begin_[b + 1];
   }
@@ -128,7 +152,9 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) const {
   Found found;
   float best = -std::numeric_limits<float>::infinity();
   const Projected* best_point = nullptr;
-  for (int across = -1; across <= 1; ++across) {
+  // A sample in the next row reaches the line only with a radius over half a pixel (nearer than ~25 m).
+  const int beside = largest_radius_px_ > 0.5f ? 1 : 0;
+  for (int across = -beside; across <= beside; ++across) {
     for (int k = -window_px_; k <= window_px_ + 1; ++k) {
       const int u = pair.u + k * pair.du + across * pair.dv, v = pair.v + k * pair.dv + across * pair.du;
       const std::int32_t b = bucket_of_[v * w + u];
@@ -151,16 +177,15 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) const {
   if (best_point == nullptr || best > window_px_ + 0.5f) return found;
   found.ok = true;
   found.offset_px = best - 0.5;
-  found.point = Eigen::Vector3d(best_point->u, best_point->v, best_point->z);  // image coordinates and depth
+  found.point = Eigen::Vector3d(best_point->u, best_point->v, best_point->z);
   return found;
 }
 
-int OccludingContours::accumulate(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
-                                  const Eigen::Vector3d& centre, double sigma_m, double sigma_px,
-                                  double limit_px, Eigen::Matrix<double, 6, 6>* H,
-                                  Eigen::Matrix<double, 6, 1>* g) {
+int OccludingContours::accumulate(const Eigen::Isometry3d& T_lidar_target, const Eigen::Vector3d& centre,
+                                  double sigma_m, double sigma_px, double limit_px,
+                                  Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g) {
   if (pairs_.empty() || candidates_.empty()) return 0;
-  project(model, T_lidar_target);
+  project(T_lidar_target);
   int rows = 0;
   for (const Pair& pair : pairs_) {
     const Found f = find(pair);
@@ -191,18 +216,6 @@ int OccludingContours::accumulate(const ReferenceModel& model, const Eigen::Isom
     ++rows;
   }
   return rows;
-}
-
-std::vector<double> OccludingContours::residualsPx(const ReferenceModel& model,
-                                                   const Eigen::Isometry3d& T_lidar_target) {
-  std::vector<double> residuals;
-  if (candidates_.empty()) return std::vector<double>(pairs_.size(), std::nan(""));
-  project(model, T_lidar_target);
-  for (const Pair& pair : pairs_) {
-    const Found f = find(pair);
-    residuals.push_back(f.ok ? f.offset_px : std::nan(""));
-  }
-  return residuals;
 }
 
 }  // namespace ardsim_pose

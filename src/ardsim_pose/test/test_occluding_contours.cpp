@@ -86,13 +86,12 @@ TEST(OccludingContourPairs, AcrossDepthEdgesOnly) {
 
 // Gauss-Newton on the contours alone from T, the range held (ICP's planes measure it) and a little ridge
 // regression.
-Eigen::Isometry3d alignContours(OccludingContours* contours, const ReferenceModel& model,
-                                Eigen::Isometry3d T) {
+Eigen::Isometry3d alignContours(OccludingContours* contours, Eigen::Isometry3d T) {
   for (int iteration = 0; iteration < 4; ++iteration) {
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
     const Eigen::Vector3d centre = T.translation();
-    EXPECT_GT(contours->accumulate(model, T, centre, 0.01, 0.3, 3.0, &H, &g), 100);
+    EXPECT_GT(contours->accumulate(T, centre, 0.01, 0.3, 3.0, &H, &g), 100);
     H += 1e-3 * Eigen::Matrix<double, 6, 6>::Identity();
     H(2, 2) += 1e6;
     const Eigen::Matrix<double, 6, 1> step = H.ldlt().solve(g);
@@ -133,7 +132,7 @@ TEST(OccludingContours, PlaceHubblesRimFarBelowAPixel) {
     OccludingContours contours(intrinsics);
     contours.extract(cloud, pixels);
     contours.selectCandidates(*model, predictor.visiblePatches(), start);
-    const Eigen::Isometry3d T = alignContours(&contours, *model, start);
+    const Eigen::Isometry3d T = alignContours(&contours, start);
     const Eigen::Vector3d port_error = T * T_target_port.translation() - truth * T_target_port.translation();
     // Across the boresight (lidar x, y): a tenth of a footprint (the start: half of one).
     EXPECT_LT(port_error.head<2>().norm(), 0.1 * footprint_m) << port_error.transpose();

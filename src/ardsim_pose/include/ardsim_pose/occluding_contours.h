@@ -40,13 +40,9 @@ class OccludingContours {
   // row per pair whose model contour lies within the window: the pair's midpoint minus the model's contour
   // along the pair's line, in metres at the contour's depth, weighted (sigma_m / the contour's sigma)^2 with
   // sigma_px the contour's own in pixels, Tukey-weighted within limit_px. Returns the rows added.
-  int accumulate(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
-                 const Eigen::Vector3d& centre, double sigma_m, double sigma_px, double limit_px,
-                 Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
-
-  // The model's contour offset (px, positive outward) of each pair at T_lidar_target, NaN where none is
-  // found within the window (tests, diagnostics).
-  std::vector<double> residualsPx(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target);
+  int accumulate(const Eigen::Isometry3d& T_lidar_target, const Eigen::Vector3d& centre, double sigma_m,
+                 double sigma_px, double limit_px, Eigen::Matrix<double, 6, 6>* H,
+                 Eigen::Matrix<double, 6, 1>* g);
 
  private:
   struct Pair {
@@ -57,10 +53,10 @@ class OccludingContours {
   struct Found {
     bool ok = false;
     double offset_px = 0.0;  // the model's contour minus the pair's midpoint, along (du, dv)
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // the model's contour point, lidar frame
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // its sample: image coordinates (px) and depth (m)
   };
   // Projects the candidates at T into their pixels' buckets.
-  void project(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target);
+  void project(const Eigen::Isometry3d& T_lidar_target);
   Found find(const Pair& pair) const;
 
   ardsim_lidar::Intrinsics intrinsics_;
@@ -71,12 +67,15 @@ class OccludingContours {
   std::vector<std::uint8_t> near_saturated_;  // scratch: per pixel, within the bloom of a saturated return
   std::vector<std::int32_t> bucket_of_;       // per pixel: its bucket (pixels near a pair's line) or -1
   int buckets_ = 0;
-  std::vector<std::uint32_t> candidates_;    // model point indices
-  std::vector<std::uint32_t> bucket_begin_;  // buckets_ + 1
+  std::vector<std::uint32_t> candidates_;                   // model point indices
+  Eigen::ArrayXf candidate_x_, candidate_y_, candidate_z_;  // their coordinates (target frame)
+  Eigen::ArrayXf candidate_radius_;                         // half their spacing, m
+  Eigen::ArrayXf u_, v_, z_;                                // scratch: their projections
+  float largest_radius_px_ = 0.0f;                          // of the projected, in pixels
+  std::vector<std::uint32_t> bucket_begin_;                 // buckets_ + 1
   struct Projected {
     float u, v, z;
     float radius_px;  // half the sample's spacing
-    std::uint32_t index;
   };
   std::vector<Projected> projected_;  // by bucket
   std::vector<Projected> scratch_;
