@@ -645,8 +645,9 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       Eigen::Matrix<double, 6, 6> H_solve = H;
       Eigen::Matrix<double, 6, 1> g_solve = g;
       const Eigen::Isometry3d* T_prior = tracking ? &T_start : T_boresight_prior;
-      if (T_prior != nullptr && options_.boresight_prior_deg > 0.0 &&
-          boresight_information < options_.boresight_prior_max_information) {
+      a.boresight_held = T_prior != nullptr && options_.boresight_prior_deg > 0.0 &&
+                         boresight_information < options_.boresight_prior_max_information;
+      if (a.boresight_held) {
         const double prior_rad =
             tracking ? trackingBoresightPriorRad() : 2.0 * options_.boresight_prior_deg * M_PI / 180.0;
         const double information = sigma * sigma / (prior_rad * prior_rad);
@@ -656,6 +657,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       }
       delta = H_solve.ldlt().solve(g_solve);
     } else {
+      a.boresight_held = false;
       delta.head<5>() = H.topLeftCorner<5, 5>().ldlt().solve(g.head<5>());
     }
     // The weak directions' part of the step (from the tangential offsets), judged on its own below.
@@ -942,6 +944,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   const double largest = eigen.eigenvalues()(5);
   const double condition = largest > 0.0 ? eigen.eigenvalues()(0) / largest : 0.0;
   result.boresight_rotation_observed = boresightObserved(H_scaled, largest);
+  result.boresight_rotation_held = !acquiring && a.boresight_held;
   // With the boresight rotation unobserved (held at its prediction, flagged), the pose is still good when
   // the other five are well constrained: judge the condition of those five.
   // The weakest of the five unknowns besides the boresight rotation, relative to the largest: also what

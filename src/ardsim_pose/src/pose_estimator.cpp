@@ -164,9 +164,12 @@ void PoseEstimator::updateVelocity(const PoseResult& result, double stamp_s) {
     return;
   }
   Eigen::Vector3d w = rotationVector(T.linear() * last_good_.linear().transpose()) / dt;
-  // A rotation about the boresight that the method did not observe (held near its prediction) is no motion:
-  // extrapolated, its noise walks the next prediction away (Hubble end-on).
-  if (!result.boresight_rotation_observed) w.z() = 0.0;
+  // A rotation about the boresight that the method did not observe, or held near its prediction, is no
+  // motion: extrapolated, its noise walks the next prediction away (Hubble end-on; hubble_hold, lidar seed 2,
+  // with the occluding contours ICP tracked 2841 of 2951 frames instead of 1871, and learnt from those in a
+  // row its held roll's noise: 30-50 m attitude RMS 0.034 deg, worst frame 0.124; held roll no motion: 0.030,
+  // 0.079).
+  if (!result.boresight_rotation_observed || result.boresight_rotation_held) w.z() = 0.0;
   const double a = velocity_valid_ ? options_.velocity_smoothing : 1.0;
   const double a_angular = angular_velocity_unlearnt_ ? 1.0 : a;  // the first pair of TRACKING ones
   velocity_mps_ = a * v + (1.0 - a) * velocity_mps_;

@@ -73,6 +73,7 @@ class MotionScript : public PoseMethod {
     EstimateStatus status = EstimateStatus::kTracking;
     bool acquiring = false;
     bool boresight_observed = true;
+    bool boresight_held = false;
   };
   explicit MotionScript(std::map<int, Step> steps) : steps_(std::move(steps)) {}
   static Eigen::Isometry3d truth(int frame) {
@@ -90,6 +91,7 @@ class MotionScript : public PoseMethod {
     result.status = step.status;
     result.acquiring = step.acquiring;
     result.boresight_rotation_observed = step.boresight_observed;
+    result.boresight_rotation_held = step.boresight_held;
     result.T_lidar_target = truth(frame);
     return result;
   }
@@ -186,18 +188,28 @@ TEST(PoseEstimatorPrediction, TheEstimateEndingAnAcquisitionGivesTheLinearVeloci
   EXPECT_LT(angleDeg(predictions.at(5), MotionScript::truth(5)), 1e-6);
 }
 
-TEST(PoseEstimatorPrediction, AnUnobservedBoresightRotationIsNoMotion) {
+// Unobserved, or observed but held near the prediction by a prior: either way no motion.
+TEST(PoseEstimatorPrediction, AnUnobservedOrHeldBoresightRotationIsNoMotion) {
   using Step = MotionScript::Step;
+  for (const bool held : {false, true}) {
+    SCOPED_TRACE(held ? "held" : "unobserved");
+    std::map<int, Step> steps;
+    for (int frame = 0; frame < 6; ++frame) steps[frame] = Step{EstimateStatus::kTracking, false, held, held};
+    const std::map<int, Eigen::Isometry3d> predictions = predictionsOver(steps, 6);
+    // The turn about lidar x is extrapolated, the one about the boresight (held by the method) is not. (The
+    // prediction's turn from frame 4 is the rotation vector's x part of one frame's turn.)
+    const Eigen::Matrix3d R = predictions.at(5).linear() * MotionScript::truth(4).linear().transpose();
+    const Eigen::AngleAxisd turn(R);
+    const Eigen::Vector3d turn_deg = turn.angle() * turn.axis() * 180.0 / M_PI;
+    EXPECT_NEAR(turn_deg.z(), 0.0, 1e-3);
+    EXPECT_NEAR(std::abs(turn_deg.x()), 0.5, 0.02);
+  }
+  // Observed and not held: extrapolated (one frame's 1 deg about the boresight).
   std::map<int, Step> steps;
-  for (int frame = 0; frame < 6; ++frame) steps[frame] = Step{EstimateStatus::kTracking, false, false};
+  for (int frame = 0; frame < 6; ++frame) steps[frame] = Step{EstimateStatus::kTracking, false, true, false};
   const std::map<int, Eigen::Isometry3d> predictions = predictionsOver(steps, 6);
-  // The turn about lidar x is extrapolated, the one about the boresight (held by the method) is not. (The
-  // prediction's turn from frame 4 is the rotation vector's x part of one frame's turn.)
-  const Eigen::Matrix3d R = predictions.at(5).linear() * MotionScript::truth(4).linear().transpose();
-  const Eigen::AngleAxisd turn(R);
-  const Eigen::Vector3d turn_deg = turn.angle() * turn.axis() * 180.0 / M_PI;
-  EXPECT_NEAR(turn_deg.z(), 0.0, 1e-3);
-  EXPECT_NEAR(std::abs(turn_deg.x()), 0.5, 0.02);
+  const Eigen::AngleAxisd turn(predictions.at(5).linear() * MotionScript::truth(4).linear().transpose());
+  EXPECT_NEAR(std::abs(turn.angle() * turn.axis().z() * 180.0 / M_PI), 1.0, 0.02);
 }
 
 // Hubble hands over to the close-range method at 20 m; the pyramid method gave poses 7 cm off beyond 12 m, so

@@ -29,6 +29,9 @@ struct PoseResult {
   Eigen::Matrix<double, 6, 6> covariance =
       Eigen::Matrix<double, 6, 6>::Zero();  // (x y z, rot x y z) m^2, rad^2
   bool boresight_rotation_observed = true;
+  // ... but barely, and held near the prediction by a prior (ICP tracking: IcpOptions::boresight_prior_*):
+  // its frame-to-frame change is the prior's and the noise's, not the target's motion.
+  bool boresight_rotation_held = false;
   // From a method still acquiring (ICP's search from a prior, after LOST): the estimate may jump from the
   // last one, so it says nothing about the motion. A DEGRADED estimate that is not acquiring still moves with
   // the target.
