@@ -181,9 +181,10 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) const {
   return found;
 }
 
-int OccludingContours::accumulate(const Eigen::Isometry3d& T_lidar_target, const Eigen::Vector3d& centre,
-                                  double sigma_m, double sigma_px, double limit_px,
-                                  Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g) {
+int OccludingContours::accumulate(bool with_boresight_rotation, const Eigen::Isometry3d& T_lidar_target,
+                                  const Eigen::Vector3d& centre, double sigma_m, double sigma_px,
+                                  double limit_px, Eigen::Matrix<double, 6, 6>* H,
+                                  Eigen::Matrix<double, 6, 1>* g) {
   if (pairs_.empty() || candidates_.empty()) return 0;
   project(T_lidar_target);
   int rows = 0;
@@ -207,6 +208,7 @@ int OccludingContours::accumulate(const Eigen::Isometry3d& T_lidar_target, const
     Eigen::Matrix<double, 6, 1> row;
     row.head<3>() = row_v;
     row.tail<3>() = (X - centre).cross(row_v);  // row_v^T (-[X - c]x) w = ((X - c) x row_v) . w
+    if (!with_boresight_rotation) row(5) = 0.0;
     const double metres_per_px = Z / f_along;
     const double e_m = -f.offset_px * metres_per_px;  // the scan's contour minus the model's
     const double sigma_contour_m = sigma_px * metres_per_px;

@@ -91,7 +91,7 @@ Eigen::Isometry3d alignContours(OccludingContours* contours, Eigen::Isometry3d T
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
     const Eigen::Vector3d centre = T.translation();
-    EXPECT_GT(contours->accumulate(T, centre, 0.01, 0.3, 3.0, &H, &g), 100);
+    EXPECT_GT(contours->accumulate(true, T, centre, 0.01, 0.3, 3.0, &H, &g), 100);
     H += 1e-3 * Eigen::Matrix<double, 6, 6>::Identity();
     H(2, 2) += 1e6;
     const Eigen::Matrix<double, 6, 1> step = H.ldlt().solve(g);

@@ -219,8 +219,10 @@ class IcpTracker : public PoseMethod {
                           Eigen::Matrix<double, 6, 1>* weak_step) const;
   // Adds the occluding contours' rows at a.T to the normal equations (H, g) of a twist about a.centre
   // (IcpOptions::contour_sigma_px): the frame's edge pairs once, the model points near them again once the
-  // pose moved a pixel or the visibility changed. Whether any row was added.
-  bool addContours(const Alignment& a, Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
+  // pose moved a pixel or the visibility changed; with_boresight_rotation: the rows measure the rotation
+  // about the boresight too. Whether any row was added.
+  bool addContours(const Alignment& a, bool with_boresight_rotation, Eigen::Matrix<double, 6, 6>* H,
+                   Eigen::Matrix<double, 6, 1>* g);
   // The smallest eigenvalue of H_scaled's first five unknowns (all but the boresight rotation).
   double weakestOfFive(const Eigen::Matrix<double, 6, 6>& H_scaled) const;
   // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the
