@@ -208,6 +208,9 @@ int OccludingContours::accumulate(bool with_boresight_rotation, const Eigen::Iso
     Eigen::Matrix<double, 6, 1> row;
     row.head<3>() = row_v;
     row.tail<3>() = (X - centre).cross(row_v);  // row_v^T (-[X - c]x) w = ((X - c) x row_v) . w
+    // Never the tilt across the boresight: the planes measure it far better (a tilted Hubble sweep at 28-18
+    // m, CloseRangeHandover: tilt RMS 0.013 -> 0.042 deg with the contours' part in it).
+    row.segment<2>(3).setZero();
     if (!with_boresight_rotation) row(5) = 0.0;
     const double metres_per_px = Z / f_along;
     const double e_m = -f.offset_px * metres_per_px;  // the scan's contour minus the model's

@@ -39,8 +39,9 @@ class OccludingContours {
   // Adds to the normal equations (H, g) of a twist (v, w) about centre, p' = p + w x (p - centre) + v, one
   // row per pair whose model contour lies within the window: the pair's midpoint minus the model's contour
   // along the pair's line, in metres at the contour's depth, weighted (sigma_m / the contour's sigma)^2 with
-  // sigma_px the contour's own in pixels, Tukey-weighted within limit_px; with_boresight_rotation false:
-  // the rows say nothing about the rotation about lidar z. Returns the rows added.
+  // sigma_px the contour's own in pixels, Tukey-weighted within limit_px. The rows measure the translation,
+  // and with with_boresight_rotation the rotation about lidar z, never the tilt across it. Returns the rows
+  // added.
   int accumulate(bool with_boresight_rotation, const Eigen::Isometry3d& T_lidar_target,
                  const Eigen::Vector3d& centre, double sigma_m, double sigma_px, double limit_px,
                  Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
