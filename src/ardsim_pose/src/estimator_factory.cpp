@@ -66,7 +66,7 @@ void applyTargetDefaults(PoseConfig* config) {
   config->icp.boresight_prior_min_deg = hubble ? 0.02 : defaults.icp.boresight_prior_min_deg;
   // Its aft bulkhead face-on leaves ICP's planes blind across it: its rim's occluding contours place it
   // (IcpOptions::contour_sigma_px; approach datasets, 24 runs, 30-50 m: port position RMS 0.8-2.3 ->
-  // 0.16-0.21 cm, worst frame 5.0 -> 0.44 cm, attitude RMS 0.019-0.045 -> 0.016-0.027 deg, both within 3x in
+  // 0.18-0.44 cm, worst frame 5.0 -> 0.84 cm, attitude RMS 0.019-0.045 -> 0.021-0.042 deg, both within 3x in
   // every run). The ISS's weak directions are inside 12 m only, on the docking adapter, whose contours near
   // the axis turned the roll there (IssCloseApproach: worst frame 0.07 -> 0.23 deg).
   config->icp.contour_sigma_px = hubble ? 0.3 : defaults.icp.contour_sigma_px;

@@ -620,8 +620,8 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
             .eigenvalues()(5);
     // The planes' information about the boresight rotation decides its prior (the contours add to it below,
-    // but whether the roll needs holding was tuned on the planes': Hubble's 30-50 m attitude RMS max 0.032 ->
-    // 0.027 deg this way).
+    // but whether the roll needs holding was tuned on the planes': Hubble's datasets, with the contours' roll
+    // in tracking then, 30-50 m attitude RMS max 0.032 -> 0.027 deg this way).
     const double boresight_information = boresightInformation(H_scaled, largest);
     // Where the planes leave directions weak (Hubble's bulkhead face-on: across it, and its roll), the
     // occluding contours measure them too (IcpOptions::contour_sigma_px). In the step only: the covariance
@@ -819,7 +819,6 @@ IcpTracker::Alignment IcpTracker::acquire(const Eigen::Isometry3d& T_prior) {
   if (!fine.failure.empty()) return fine;
   const Alignment own =
       align(fine.T, options_.gate_tracking_m, options_.max_iterations_acquisition, false, 1);
-
   // 3. From the second acquisition frame on, a barely observed boresight rotation near the prediction's is
   // held near it (IcpOptions::acquisition_boresight_gate_deg).
   if (!own.failure.empty() || acquired_.empty() || options_.acquisition_boresight_gate_deg <= 0.0) return own;

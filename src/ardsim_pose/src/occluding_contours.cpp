@@ -30,7 +30,8 @@ void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<i
     if (p.allFinite() && p.z() > 0.0f) depth_[i] = p.z();
   }
   // Saturated returns (retro-reflectors) bloom into the pixels around them at their own range: near one,
-  // an edge is not where the surface ends (Hubble's reflector targets at 10-15 m turned the roll 0.3 deg).
+  // an edge is not where the surface ends. (Hubble's few reflector pixels left the approach datasets' bands
+  // the same either way.)
   near_saturated_.assign(static_cast<std::size_t>(w) * h, 0);
   if (cloud.intensity.size() == cloud.points.size()) {
     for (int i = 0; i < w * h; ++i) {
@@ -152,7 +153,8 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) const {
   Found found;
   float best = -std::numeric_limits<float>::infinity();
   const Projected* best_point = nullptr;
-  // A sample in the next row reaches the line only with a radius over half a pixel (nearer than ~25 m).
+  // A sample in the next row reaches the line only with a radius over half a pixel (near: Hubble's rim,
+  // sampled every 2.3 cm, inside ~17 m).
   const int beside = largest_radius_px_ > 0.5f ? 1 : 0;
   for (int across = -beside; across <= beside; ++across) {
     for (int k = -window_px_; k <= window_px_ + 1; ++k) {
@@ -198,8 +200,8 @@ int OccludingContours::accumulate(bool with_boresight_rotation, const Eigen::Iso
     const double Z = f.point.z();
     const Eigen::Vector3d X((f.point.x() - intrinsics_.cx) * Z / intrinsics_.fx,
                             (f.point.y() - intrinsics_.cy) * Z / intrinsics_.fy, Z);
-    // The contour's image motion along (du, dv) for a twist, in metres at its depth: d^T dpi/dX [1, -[X -
-    // c]x].
+    // The contour's image motion along d = (du, dv) for a twist, in metres at its depth:
+    // d^T dpi/dX [1, -[X - c]x].
     const double f_along = pair.du != 0 ? intrinsics_.fx : intrinsics_.fy;
     const Eigen::Vector3d dpi(
         pair.du * intrinsics_.fx / Z, pair.dv * intrinsics_.fy / Z,

@@ -52,10 +52,10 @@ struct IcpOptions {
   // Where the plane residuals leave such weak directions, or the boresight rotation barely observed (below
   // boresight_prior_max_information), the scan's occluding contours are measured with them
   // (OccludingContours: pairs of pixels across a depth edge, the model's contour between their centres),
-  // which place a rim to a fraction of a pixel where the offsets stop at half one, and the roll by the edges
-  // of off-axis structure (Hubble's masts): the contour's standard deviation in pixels (half a pixel either
-  // way, evenly: 0.29, and the model's sampling). 0: the planes (and offsets) alone. By target: 0 (the
-  // ISS), 0.3 (Hubble; applyTargetDefaults says why).
+  // which place a rim to a fraction of a pixel where the offsets stop at half one (and, while acquiring, the
+  // roll by the edges of off-axis structure: Hubble's masts): the contour's standard deviation in pixels
+  // (half a pixel either way, evenly: 0.29, and the model's sampling). 0: the planes (and offsets) alone. By
+  // target: 0 (the ISS), 0.3 (Hubble; applyTargetDefaults says why).
   double contour_sigma_px = 0.0;
   double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
   // Tracking: the rotation about the boresight is held near the prediction with this standard deviation

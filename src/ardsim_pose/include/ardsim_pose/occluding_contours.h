@@ -4,9 +4,9 @@
 // points place its rim only to the sampling (they carry no information within half a pixel's footprint).
 // Here each pair of neighbouring pixels across a depth edge of the scan (a return, and beside it none or one
 // much farther) says the contour crosses between their centres; the model's contour along that line at a
-// pose is the outermost of its visible points in the pixel row (or column) near the return's depth. The
-// midpoint is off by at most half a pixel, evenly either way, so hundreds of pairs place the contour far
-// better than a pixel. ROS-free.
+// pose is the outermost reach of its visible samples (discs of half their spacing) there, near the return's
+// depth. The midpoint is off by at most half a pixel, evenly either way, so hundreds of pairs place the
+// contour far better than a pixel. ROS-free.
 #pragma once
 
 #include <cstdint>
