@@ -10,6 +10,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "require_option.h"
+#include "tukey_weight.h"
 
 namespace ardsim_pose {
 
@@ -54,12 +55,6 @@ double median(std::vector<double>* values) {
   auto middle = values->begin() + values->size() / 2;
   std::nth_element(values->begin(), middle, values->end());
   return *middle;
-}
-
-// Tukey's biweight of a residual against its limit (0 beyond it).
-double tukeyWeight(double residual, double limit) {
-  const double u = residual / limit;
-  return std::abs(u) < 1.0 ? (1.0 - u * u) * (1.0 - u * u) : 0.0;
 }
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "tukey_weight.h"
+
 namespace ardsim_pose {
 
 namespace {
@@ -139,8 +141,9 @@ void OccludingContours::project(const Eigen::Isometry3d& T_lidar_target) {
   }
   for (int b = 0; b < buckets_; ++b) bucket_begin_[b + 1] += bucket_begin_[b];
   projected_.resize(scratch_.size());
-  std::vector<std::uint32_t> next(bucket_begin_.begin(), bucket_begin_.end() - 1);
-  for (std::size_t k = 0; k < scratch_.size(); ++k) projected_[next[bucket_scratch_[k]]++] = scratch_[k];
+  bucket_next_.assign(bucket_begin_.begin(), bucket_begin_.end() - 1);
+  for (std::size_t k = 0; k < scratch_.size(); ++k)
+    projected_[bucket_next_[bucket_scratch_[k]]++] = scratch_[k];
 }
 
 OccludingContours::Found OccludingContours::find(const Pair& pair) const {
@@ -193,9 +196,8 @@ int OccludingContours::accumulate(bool with_boresight_rotation, const Eigen::Iso
   for (const Pair& pair : pairs_) {
     const Found f = find(pair);
     if (!f.ok) continue;
-    const double u = f.offset_px / limit_px;
-    if (std::abs(u) >= 1.0) continue;
-    const double tukey = (1.0 - u * u) * (1.0 - u * u);
+    const double tukey = tukeyWeight(f.offset_px, limit_px);
+    if (tukey == 0.0) continue;
     // Back from the image to the contour point (lidar frame) at its depth.
     const double Z = f.point.z();
     const Eigen::Vector3d X((f.point.x() - intrinsics_.cx) * Z / intrinsics_.fx,

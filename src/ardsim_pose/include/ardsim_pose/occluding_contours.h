@@ -82,6 +82,7 @@ class OccludingContours {
   std::vector<Projected> projected_;  // by bucket
   std::vector<Projected> scratch_;
   std::vector<std::int32_t> bucket_scratch_;
+  std::vector<std::uint32_t> bucket_next_;  // scratch: the counting sort's next slot per bucket
 };
 
 }  // namespace ardsim_pose
