@@ -96,6 +96,13 @@ void PoseEstimator::compose(const PoseResult& icp, const PoseResult& ring, PoseR
   const Eigen::Vector3d port_m = ring.T_lidar_target * T_target_port_.translation();
   result->T_lidar_target.linear() = R;
   result->T_lidar_target.translation() = port_m - R * T_target_port_.translation();
+  if (icp_roll) {
+    // The roll is ICP's, and so is whether it was observed or held near its prediction: the prediction
+    // learns no roll rate from a held roll (with the ring's flags it learnt one from ICP's held roll, and the
+    // two methods' held rolls walked off together: Hubble at 10-20 m, 1.5 deg).
+    result->boresight_rotation_observed = icp.boresight_rotation_observed;
+    result->boresight_rotation_held = icp.boresight_rotation_held;
+  }
 }
 
 void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {

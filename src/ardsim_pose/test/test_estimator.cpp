@@ -278,12 +278,16 @@ class FixedPoseMethod : public PoseMethod {
     result.T_lidar_target = T_;
     const double sigma_rad = sigma_deg * M_PI / 180.0;
     result.covariance = Eigen::Matrix<double, 6, 6>::Identity() * sigma_rad * sigma_rad;
+    result.boresight_rotation_observed = boresight_observed;
+    result.boresight_rotation_held = boresight_held;
     return result;
   }
   void reset() override {}
   std::map<int, EstimateStatus> status;
   int calls = 0;
   double sigma_deg = 1.0;  // of every part of the pose (as m or deg): a roll the composite leaves alone
+  bool boresight_observed = true;
+  bool boresight_held = false;
 
  private:
   Eigen::Isometry3d T_;
@@ -396,6 +400,39 @@ TEST(PoseEstimatorComposite, RollFromIcpWhereIcpMeasuresItWell) {
       EXPECT_LT(from_icp_deg.head<2>().norm(), 2e-3);  // ICP DEGRADED: its tilt, the ring's roll
       EXPECT_LT(std::abs(from_ring_deg.z()), 1e-9);
     }
+  }
+}
+
+// ICP's roll held near its prediction by its prior: when the composite takes it, the pose's roll is held (no
+// motion for the prediction), whatever the ring said of its own; when it does not, the ring's flags stand.
+TEST(PoseEstimatorComposite, TheRollTakenFromIcpIsObservedOrHeldAsIcpSaid) {
+  const Eigen::Isometry3d T_icp = offTruth(turnDeg(0.02, -0.03, 0.4), Eigen::Vector3d(0.02, -0.015, 0.01));
+  const Eigen::Isometry3d T_ring = offTruth(turnDeg(0.12, 0.09, -0.2), Eigen::Vector3d(0.001, 0.0, -0.001));
+  for (const double icp_sigma_deg : {0.004, 1.0}) {
+    SCOPED_TRACE("ICP's roll sigma " + std::to_string(icp_sigma_deg) + " deg");
+    auto icp = std::make_unique<FixedPoseMethod>(T_icp);
+    icp->sigma_deg = icp_sigma_deg;
+    icp->boresight_held = true;
+    auto ring = std::make_unique<FixedPoseMethod>(T_ring);
+    ring->boresight_observed = false;
+    PoseEstimator::Methods methods;
+    methods[EstimateMethod::kIcp] = std::move(icp);
+    methods[EstimateMethod::kRing] = std::move(ring);
+    EstimatorOptions options;
+    options.composite_min_port_range_m = 10.0;
+    options.composite_max_port_range_m = 30.0;
+    options.composite_icp_roll_max_sigma_deg = 0.01;
+    PoseEstimator estimator(options, std::move(methods),
+                            std::make_unique<FixedMethodSelector>(EstimateMethod::kRing), portTarget());
+    estimator.setPrior(compositeTruth());
+    OrganizedCloud cloud;
+    const PoseResult result = estimator.process(cloud).result;
+    const bool icp_roll = icp_sigma_deg < options.composite_icp_roll_max_sigma_deg;
+    const Eigen::Vector3d from_icp_deg =
+        rotationVectorOf(result.T_lidar_target.linear() * T_icp.linear().transpose()) * 180 / M_PI;
+    EXPECT_EQ(from_icp_deg.norm() < 1e-9, icp_roll);
+    EXPECT_EQ(result.boresight_rotation_observed, icp_roll);
+    EXPECT_EQ(result.boresight_rotation_held, icp_roll);
   }
 }
 
