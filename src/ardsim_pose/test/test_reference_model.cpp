@@ -1,6 +1,6 @@
 // The visible-point grid against the KD-tree it stands in front of: where it answers, the same nearest
 // visible point and a ball that holds every visible point within its radius; and it answers most queries
-// near the surface (what makes it worth building).
+// near the surface (what makes it worth building). The patches of parts that turn are flagged.
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -96,6 +96,28 @@ INSTANTIATE_TEST_SUITE_P(Poses, VisiblePointGridCase,
                          ::testing::Values(GridCase{100.0, 0.0, 0.0}, GridCase{30.0, 0.0, 0.0},
                                            GridCase{10.0, 0.0, 0.0}, GridCase{30.0, 8.0, 3.0},
                                            GridCase{10.0, -12.0, -2.0}));
+
+// Hubble's rigid model has no part that turns; with its arrays put in at an angle, exactly the arrays'
+// patches (2.6 m wide about the mast axis, x = -1.5 m; 3 to 10.1 m out along y) say they are articulated.
+TEST(ReferenceModelPatches, ThoseOfPartsThatTurnAreFlagged) {
+  const PoseConfig config;
+  const std::shared_ptr<const ReferenceModel> rigid = buildReferenceModel(TargetKind::kHubble, config.model);
+  for (const ReferenceModel::Patch& patch : rigid->patches()) ASSERT_FALSE(patch.articulated);
+  const std::shared_ptr<const ReferenceModel> with_arrays =
+      buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 30.0 * M_PI / 180.0);
+  int articulated = 0;
+  for (const ReferenceModel::Patch& patch : with_arrays->patches()) {
+    for (std::uint32_t j = patch.begin; j < patch.end; ++j) {
+      const Eigen::Vector3f& p = with_arrays->points()[j];
+      if (std::abs(std::abs(p.y()) - 3.0f) < 0.01f) continue;  // where the masts' ends meet the arrays
+      const bool on_an_array =
+          std::abs(p.y()) > 3.0f && std::abs(p.y()) < 10.11f && std::hypot(p.x() + 1.5f, p.z()) < 1.31f;
+      ASSERT_EQ(patch.articulated, on_an_array) << "point (" << p.transpose() << ")";
+    }
+    articulated += patch.articulated ? 1 : 0;
+  }
+  EXPECT_GT(articulated, 100);
+}
 
 }  // namespace
 }  // namespace ardsim_pose

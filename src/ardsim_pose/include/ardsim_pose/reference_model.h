@@ -81,6 +81,9 @@ class ReferenceModel {
   struct Patch {  // its centre, normal and bounding radius: patchCentres, patchNormals, patchRadii
     std::uint32_t begin = 0;
     std::uint32_t end = 0;
+    // Of a part that turns (ardsim_description::Part::articulated: Hubble's arrays, in the model at the angle
+    // the scans measure): where it ends is only as good as that angle.
+    bool articulated = false;
   };
   // Patches close together: one frustum test for all (patches [begin, end)).
   struct Chunk {
