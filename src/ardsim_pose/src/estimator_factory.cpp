@@ -71,8 +71,9 @@ void applyTargetDefaults(PoseConfig* config) {
   // Its aft bulkhead face-on leaves ICP's planes blind across it: its rim's occluding contours place it
   // (IcpOptions::contour_sigma_px; approach datasets, 24 runs, 30-50 m: port position RMS 0.8-2.3 ->
   // 0.18-0.44 cm, worst frame 5.0 -> 0.84 cm, attitude RMS 0.019-0.045 -> 0.021-0.042 deg, both within 3x in
-  // every run). The ISS's weak directions are inside 12 m only, on the docking adapter, whose contours near
-  // the axis turned the roll there (IssCloseApproach: worst frame 0.07 -> 0.23 deg).
+  // every run; without the arrays' edges, session 22: 0.15-0.21 cm, 0.016-0.033 deg). The ISS's weak
+  // directions are inside 12 m only, on the docking adapter, whose contours near the axis turned the roll
+  // there (IssCloseApproach: worst frame 0.07 -> 0.23 deg).
   config->icp.contour_sigma_px = hubble ? 0.3 : defaults.icp.contour_sigma_px;
   // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43
   // deg RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
