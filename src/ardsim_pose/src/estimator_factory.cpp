@@ -61,10 +61,10 @@ void applyTargetDefaults(PoseConfig* config) {
   // ... and tightens to 0.02 deg once tracked for 36 frames (IcpOptions::boresight_prior_frames): hubble_hold
   // over lidar seeds 2, 11, 23, 37, 51, ICP 30-50 m attitude RMS 0.030-0.082 -> 0.018-0.026 deg, worst frame
   // 0.14-0.52 -> 0.050-0.17; the approach datasets' bands as before (at 0.5 m a frame, 36 frames take them
-  // from 51 to 33 m). Down to 0.01 deg (session 22; 0.02 from 225 frames, 0.01 from 900): the roll measured
-  // on the masts at 30-50 m is ~0.1 deg a frame, good to ~0.025 when a row of pixels falls on a mast's
-  // grazing side and ~0.07 when not, which changes with the sub-pixel phase over seconds; averaged longer,
-  // the same five seeds 0.019-0.022 -> 0.016-0.017 deg, worst frame 0.051-0.10 -> 0.038-0.055 (a 2 deg roll
+  // from 51 to 33 m). Down to 0.01 deg (session 22; 0.02 from 225 frames, 0.01 from 900): a frame's roll,
+  // measured on the masts at 30-50 m, is good to ~0.025 deg when a row of pixels falls on a mast's grazing
+  // side and to ~0.07 when not, which changes with the sub-pixel phase over seconds; averaged longer, the
+  // same five seeds 0.019-0.022 -> 0.016-0.017 deg, worst frame 0.051-0.10 -> 0.038-0.055 (a 2 deg roll
   // offset at the start, turning at 0.05 deg/s: seed 2 0.020 -> 0.016, worst 0.076 -> 0.043).
   config->icp.boresight_prior_frames = hubble ? 36 : defaults.icp.boresight_prior_frames;
   config->icp.boresight_prior_min_deg = hubble ? 0.01 : defaults.icp.boresight_prior_min_deg;
