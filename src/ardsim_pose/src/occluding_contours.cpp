@@ -91,7 +91,7 @@ void OccludingContours::selectCandidates(const ReferenceModel& model,
     // Not the edges of what turns: Hubble's arrays in the model sit at the angle the scans measure, and their
     // edges, metres off the axis, moved the estimate across it by that angle's error, which the planes then
     // answered with a tilt (hubble_hold_arrays30, 20-30 m tilt RMS 0.013 -> 0.029 deg with them).
-    if (range.articulated) continue;
+    if (model.patchArticulated(patch)) continue;
     for (std::uint32_t j = range.begin; j < range.end; ++j) {
       const Eigen::Vector3f X = R * model.points()[j] + t;
       if (!(X.z() > 0.0f)) continue;

@@ -209,9 +209,9 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
       Patch patch;
       patch.begin = static_cast<std::uint32_t>(points_.size());
       const std::uint32_t triangle = triangle_of[members->front()];
-      patch.articulated = triangle < mesh.triangle_part.size() &&
-                          mesh.triangle_part[triangle] < mesh.parts.size() &&
-                          mesh.parts[mesh.triangle_part[triangle]].articulated;
+      patch_articulated_.push_back(triangle < mesh.triangle_part.size() &&
+                                   mesh.triangle_part[triangle] < mesh.parts.size() &&
+                                   mesh.parts[mesh.triangle_part[triangle]].articulated);
       patch_normals.push_back(normals[members->front()]);
       Eigen::AlignedBox3f box;
       for (std::uint32_t i : *members) {

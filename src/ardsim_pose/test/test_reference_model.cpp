@@ -102,19 +102,22 @@ INSTANTIATE_TEST_SUITE_P(Poses, VisiblePointGridCase,
 TEST(ReferenceModelPatches, ThoseOfPartsThatTurnAreFlagged) {
   const PoseConfig config;
   const std::shared_ptr<const ReferenceModel> rigid = buildReferenceModel(TargetKind::kHubble, config.model);
-  for (const ReferenceModel::Patch& patch : rigid->patches()) ASSERT_FALSE(patch.articulated);
+  for (std::uint32_t patch = 0; patch < rigid->patches().size(); ++patch)
+    ASSERT_FALSE(rigid->patchArticulated(patch));
   const std::shared_ptr<const ReferenceModel> with_arrays =
       buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 30.0 * M_PI / 180.0);
   int articulated = 0;
-  for (const ReferenceModel::Patch& patch : with_arrays->patches()) {
+  for (std::uint32_t k = 0; k < with_arrays->patches().size(); ++k) {
+    const ReferenceModel::Patch& patch = with_arrays->patches()[k];
+    const bool flagged = with_arrays->patchArticulated(k);
     for (std::uint32_t j = patch.begin; j < patch.end; ++j) {
       const Eigen::Vector3f& p = with_arrays->points()[j];
       if (std::abs(std::abs(p.y()) - 3.0f) < 0.01f) continue;  // where the masts' ends meet the arrays
       const bool on_an_array =
           std::abs(p.y()) > 3.0f && std::abs(p.y()) < 10.11f && std::hypot(p.x() + 1.5f, p.z()) < 1.31f;
-      ASSERT_EQ(patch.articulated, on_an_array) << "point (" << p.transpose() << ")";
+      ASSERT_EQ(flagged, on_an_array) << "point (" << p.transpose() << ")";
     }
-    articulated += patch.articulated ? 1 : 0;
+    articulated += flagged ? 1 : 0;
   }
   EXPECT_GT(articulated, 100);
 }

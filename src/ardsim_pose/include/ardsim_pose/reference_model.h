@@ -81,9 +81,6 @@ class ReferenceModel {
   struct Patch {  // its centre, normal and bounding radius: patchCentres, patchNormals, patchRadii
     std::uint32_t begin = 0;
     std::uint32_t end = 0;
-    // Of a part that turns (ardsim_description::Part::articulated: Hubble's arrays, in the model at the angle
-    // the scans measure): where it ends is only as good as that angle.
-    bool articulated = false;
   };
   // Patches close together: one frustum test for all (patches [begin, end)).
   struct Chunk {
@@ -93,6 +90,9 @@ class ReferenceModel {
     std::uint32_t end = 0;
   };
   const std::vector<Patch>& patches() const { return patches_; }
+  // Whether a patch is of a part that turns (ardsim_description::Part::articulated: Hubble's arrays, in the
+  // model at the angle the scans measure): where it ends is only as good as that angle.
+  bool patchArticulated(std::uint32_t patch) const { return patch_articulated_[patch] != 0; }
   // The patches' centres, normals (axis 0-2) and radii as arrays (vectorized per chunk).
   const Eigen::ArrayXf& patchCentres(int axis) const { return patch_centres_[axis]; }
   const Eigen::ArrayXf& patchNormals(int axis) const { return patch_normals_[axis]; }
@@ -109,6 +109,7 @@ class ReferenceModel {
   std::array<Eigen::ArrayXf, 3> patch_normals_;
   Eigen::ArrayXf patch_radii_;
   std::vector<Patch> patches_;
+  std::vector<std::uint8_t> patch_articulated_;  // beside patches_: their loops read begin and end only
   std::vector<Chunk> chunks_;
   std::unique_ptr<KdTree> tree_;
 };
