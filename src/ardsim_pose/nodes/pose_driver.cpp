@@ -117,6 +117,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "estimator/median_filter", &c.estimator.median_filter);
   read(nh, "estimator/median_window", &c.estimator.median_window);
   read(nh, "estimator/velocity_smoothing", &c.estimator.velocity_smoothing);
+  read(nh, "estimator/angular_velocity_smoothing", &c.estimator.angular_velocity_smoothing);
   read(nh, "estimator/max_prediction_gap_s", &c.estimator.max_prediction_gap_s);
   read(nh, "estimator/composite_min_port_range_m", &c.estimator.composite_min_port_range_m);
   read(nh, "estimator/composite_max_port_range_m", &c.estimator.composite_max_port_range_m);

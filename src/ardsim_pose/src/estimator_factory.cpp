@@ -96,6 +96,9 @@ void applyTargetDefaults(PoseConfig* config) {
   config->estimator.composite_min_port_range_m = hubble ? 10.0 : 7.0;
   config->estimator.composite_max_port_range_m = hubble ? 30.0 : 12.5;
   config->estimator.composite_icp_roll_max_sigma_deg = hubble ? 1.0 : 0.03;
+  // Hubble's tilt at 30-50 m is a frame's to ~0.02-0.05 deg: its rotation rate learns from several
+  // (EstimatorOptions::angular_velocity_smoothing).
+  config->estimator.angular_velocity_smoothing = hubble ? 0.2 : 0.5;
 }
 
 std::shared_ptr<const ReferenceModel> buildReferenceModel(ardsim_description::TargetKind kind,

@@ -41,6 +41,9 @@ void validate(const EstimatorOptions& o) {
   if (!(o.velocity_smoothing > 0.0 && o.velocity_smoothing <= 1.0))
     throw std::invalid_argument("velocity_smoothing = " + std::to_string(o.velocity_smoothing) +
                                 " is out of range: > 0 .. 1");
+  if (!(o.angular_velocity_smoothing > 0.0 && o.angular_velocity_smoothing <= 1.0))
+    throw std::invalid_argument("estimator/angular_velocity_smoothing = " +
+                                std::to_string(o.angular_velocity_smoothing) + " is out of range: > 0 .. 1");
   if (!(std::isfinite(o.max_prediction_gap_s) && o.max_prediction_gap_s >= 0.0))
     throw std::invalid_argument("max_prediction_gap_s = " + std::to_string(o.max_prediction_gap_s) +
                                 " is out of range: >= 0");
@@ -109,7 +112,6 @@ void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
   prior_ = T_lidar_target;
   have_good_ = false;
   velocity_valid_ = false;
-  angular_velocity_unlearnt_ = false;
   velocity_mps_.setZero();
   angular_velocity_radps_.setZero();
   have_previous_ = false;
@@ -134,19 +136,18 @@ void PoseEstimator::updateVelocity(const PoseResult& result, double stamp_s) {
   const double dt = stamp_s - last_good_stamp_s;
   const bool valid_pair = have_good_ && dt > 0.0 && dt <= options_.max_prediction_gap_s;
   // The estimate that ends an acquisition agreed with the acquisition estimate before it, or with the motion
-  // of the two before: from that pair the linear velocity (the angular one from the next TRACKING pair).
+  // of the two before: from that pair the linear velocity (the angular one from the next TRACKING pairs).
   // Without it, at the approach datasets' 0.5 m a frame, Hubble's first tracking frames started 0.5 m off.
   if (valid_pair && result.acquiring && last_good_acquiring_ && result.status == EstimateStatus::kTracking) {
     velocity_mps_ = (T.translation() - last_good_.translation()) / dt;
     angular_velocity_radps_.setZero();
     velocity_valid_ = true;
-    angular_velocity_unlearnt_ = true;
     return;
   }
   // The jumps of an acquisition are no motion: its other estimates reset the velocity.
   if (!valid_pair || result.acquiring) {
     velocity_valid_ = false;
-    angular_velocity_unlearnt_ = false;
+    angular_velocity_radps_.setZero();
     return;
   }
   // Learnt from TRACKING estimates in a row only. A DEGRADED estimate between them keeps the linear velocity
@@ -166,7 +167,6 @@ void PoseEstimator::updateVelocity(const PoseResult& result, double stamp_s) {
     if (!velocity_valid_ && !last_good_acquiring_ && result.status == EstimateStatus::kTracking) {
       velocity_mps_ = v;
       velocity_valid_ = true;
-      angular_velocity_unlearnt_ = true;
     }
     return;
   }
@@ -178,11 +178,11 @@ void PoseEstimator::updateVelocity(const PoseResult& result, double stamp_s) {
   // 0.079).
   if (!result.boresight_rotation_observed || result.boresight_rotation_held) w.z() = 0.0;
   const double a = velocity_valid_ ? options_.velocity_smoothing : 1.0;
-  const double a_angular = angular_velocity_unlearnt_ ? 1.0 : a;  // the first pair of TRACKING ones
   velocity_mps_ = a * v + (1.0 - a) * velocity_mps_;
+  // The rotation rate from zero (each reset above), by its own weight (EstimatorOptions).
+  const double a_angular = options_.angular_velocity_smoothing;
   angular_velocity_radps_ = a_angular * w + (1.0 - a_angular) * angular_velocity_radps_;
   velocity_valid_ = true;
-  angular_velocity_unlearnt_ = false;
 }
 
 Eigen::Isometry3d PoseEstimator::medianOf(const std::deque<std::pair<double, Eigen::Isometry3d>>& recent,

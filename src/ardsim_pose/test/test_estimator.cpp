@@ -74,6 +74,7 @@ class MotionScript : public PoseMethod {
     bool acquiring = false;
     bool boresight_observed = true;
     bool boresight_held = false;
+    double tilt_error_deg = 0.0;  // the estimate turned this far about lidar y from the truth
   };
   explicit MotionScript(std::map<int, Step> steps) : steps_(std::move(steps)) {}
   static Eigen::Isometry3d truth(int frame) {
@@ -93,6 +94,9 @@ class MotionScript : public PoseMethod {
     result.boresight_rotation_observed = step.boresight_observed;
     result.boresight_rotation_held = step.boresight_held;
     result.T_lidar_target = truth(frame);
+    result.T_lidar_target.linear() =
+        Eigen::AngleAxisd(step.tilt_error_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix() *
+        result.T_lidar_target.linear();
     return result;
   }
   void reset() override {}
@@ -102,13 +106,21 @@ class MotionScript : public PoseMethod {
   std::map<int, Step> steps_;
 };
 
+// The rotation rate taken whole from each TRACKING pair: the script's constant rate predicted exactly.
+EstimatorOptions wholeRate() {
+  EstimatorOptions options;
+  options.angular_velocity_smoothing = 1.0;
+  return options;
+}
+
 // The prediction each of frames 0 .. frames-1 was given by an estimator over MotionScript(steps).
-std::map<int, Eigen::Isometry3d> predictionsOver(std::map<int, MotionScript::Step> steps, int frames) {
+std::map<int, Eigen::Isometry3d> predictionsOver(std::map<int, MotionScript::Step> steps, int frames,
+                                                 const EstimatorOptions& options = wholeRate()) {
   auto script = std::make_unique<MotionScript>(std::move(steps));
   MotionScript* probe = script.get();
   PoseEstimator::Methods methods;
   methods[EstimateMethod::kIcp] = std::move(script);
-  PoseEstimator estimator(EstimatorOptions{}, std::move(methods),
+  PoseEstimator estimator(options, std::move(methods),
                           std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
   estimator.setPrior(MotionScript::truth(0));
   OrganizedCloud cloud;
@@ -210,6 +222,31 @@ TEST(PoseEstimatorPrediction, AnUnobservedOrHeldBoresightRotationIsNoMotion) {
   const std::map<int, Eigen::Isometry3d> predictions = predictionsOver(steps, 6);
   const Eigen::AngleAxisd turn(predictions.at(5).linear() * MotionScript::truth(4).linear().transpose());
   EXPECT_NEAR(std::abs(turn.angle() * turn.axis().z() * 180.0 / M_PI), 1.0, 0.02);
+}
+
+// The rotation rate starts at zero and learns from each TRACKING pair by angular_velocity_smoothing: a
+// single frame's attitude error moves the next prediction by that fraction of it again (Hubble, 0.2), not
+// by all of it (whole: the next prediction twice as far off, the other frames' estimates the same).
+TEST(PoseEstimatorPrediction, TheRotationRateLearnsFromSeveralFrames) {
+  using Step = MotionScript::Step;
+  EstimatorOptions hubble;
+  hubble.angular_velocity_smoothing = 0.2;
+  // From zero: after n TRACKING pairs the prediction carries 1 - 0.8^n of the script's turn per frame.
+  const std::map<int, Eigen::Isometry3d> learning = predictionsOver({}, 6, hubble);
+  const double turn_deg = std::hypot(0.5, 1.0);
+  for (int frame = 2; frame < 6; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    const double learnt = 1.0 - std::pow(0.8, frame - 1);
+    EXPECT_NEAR(angleDeg(learning.at(frame), MotionScript::truth(frame)), (1.0 - learnt) * turn_deg, 0.01);
+  }
+  // Rate learnt (frame 40: 0.8^39 of it left), then one estimate 0.05 deg off about lidar y.
+  std::map<int, Step> steps;
+  steps[40] = Step{EstimateStatus::kTracking, false, true, false, 0.05};
+  const std::map<int, Eigen::Isometry3d> smoothed = predictionsOver(steps, 42, hubble);
+  const std::map<int, Eigen::Isometry3d> whole = predictionsOver(steps, 42);
+  EXPECT_LT(angleDeg(smoothed.at(40), MotionScript::truth(40)), 1e-3);
+  EXPECT_NEAR(angleDeg(smoothed.at(41), MotionScript::truth(41)), 0.05 * 1.2, 2e-3);
+  EXPECT_NEAR(angleDeg(whole.at(41), MotionScript::truth(41)), 0.05 * 2.0, 2e-3);
 }
 
 // Hubble hands over to the close-range method at 20 m; the pyramid method gave poses 7 cm off beyond 12 m, so
