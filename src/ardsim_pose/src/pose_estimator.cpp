@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "require_option.h"
+
 namespace ardsim_pose {
 
 namespace {
@@ -38,30 +40,23 @@ void validate(const EstimatorOptions& o) {
   if (o.median_window < 1 || o.median_window > 51 || o.median_window % 2 == 0)
     throw std::invalid_argument("median_window = " + std::to_string(o.median_window) +
                                 " is out of range: odd, 1 .. 51");
-  if (!(o.velocity_smoothing > 0.0 && o.velocity_smoothing <= 1.0))
-    throw std::invalid_argument("velocity_smoothing = " + std::to_string(o.velocity_smoothing) +
-                                " is out of range: > 0 .. 1");
-  if (!(o.angular_velocity_smoothing > 0.0 && o.angular_velocity_smoothing <= 1.0))
-    throw std::invalid_argument("estimator/angular_velocity_smoothing = " +
-                                std::to_string(o.angular_velocity_smoothing) + " is out of range: > 0 .. 1");
-  if (!(std::isfinite(o.max_prediction_gap_s) && o.max_prediction_gap_s >= 0.0))
-    throw std::invalid_argument("max_prediction_gap_s = " + std::to_string(o.max_prediction_gap_s) +
-                                " is out of range: >= 0");
+  requireOption(o.velocity_smoothing > 0.0 && o.velocity_smoothing <= 1.0, "velocity_smoothing",
+                o.velocity_smoothing, "> 0 .. 1");
+  requireOption(o.angular_velocity_smoothing > 0.0 && o.angular_velocity_smoothing <= 1.0,
+                "estimator/angular_velocity_smoothing", o.angular_velocity_smoothing, "> 0 .. 1");
+  requireOption(std::isfinite(o.max_prediction_gap_s) && o.max_prediction_gap_s >= 0.0,
+                "max_prediction_gap_s", o.max_prediction_gap_s, ">= 0");
   const bool composite_off = o.composite_min_port_range_m == 0.0 && o.composite_max_port_range_m == 0.0;
-  if (!composite_off && !(o.composite_min_port_range_m >= 0.0 && o.composite_min_port_range_m <= 1000.0))
-    throw std::invalid_argument(
-        "estimator/composite_min_port_range_m = " + std::to_string(o.composite_min_port_range_m) +
-        " is out of range: 0 .. 1000 (both 0: off)");
-  if (!composite_off && !(o.composite_max_port_range_m > o.composite_min_port_range_m &&
-                          o.composite_max_port_range_m <= 1000.0))
-    throw std::invalid_argument(
-        "estimator/composite_max_port_range_m = " + std::to_string(o.composite_max_port_range_m) +
-        " is out of range: > composite_min_port_range_m .. 1000 (both 0: off)");
-  if (!(std::isfinite(o.composite_icp_roll_max_sigma_deg) && o.composite_icp_roll_max_sigma_deg >= 0.0 &&
-        o.composite_icp_roll_max_sigma_deg <= 180.0))
-    throw std::invalid_argument(
-        "estimator/composite_icp_roll_max_sigma_deg = " + std::to_string(o.composite_icp_roll_max_sigma_deg) +
-        " is out of range: 0 .. 180");
+  requireOption(
+      composite_off || (o.composite_min_port_range_m >= 0.0 && o.composite_min_port_range_m <= 1000.0),
+      "estimator/composite_min_port_range_m", o.composite_min_port_range_m, "0 .. 1000 (both 0: off)");
+  requireOption(composite_off || (o.composite_max_port_range_m > o.composite_min_port_range_m &&
+                                  o.composite_max_port_range_m <= 1000.0),
+                "estimator/composite_max_port_range_m", o.composite_max_port_range_m,
+                "> composite_min_port_range_m .. 1000 (both 0: off)");
+  requireOption(std::isfinite(o.composite_icp_roll_max_sigma_deg) &&
+                    o.composite_icp_roll_max_sigma_deg >= 0.0 && o.composite_icp_roll_max_sigma_deg <= 180.0,
+                "estimator/composite_icp_roll_max_sigma_deg", o.composite_icp_roll_max_sigma_deg, "0 .. 180");
 }
 
 PoseEstimator::PoseEstimator(const EstimatorOptions& options, Methods methods,

@@ -247,6 +247,8 @@ TEST(PoseEstimatorPrediction, TheRotationRateLearnsFromSeveralFrames) {
   EXPECT_LT(angleDeg(smoothed.at(40), MotionScript::truth(40)), 1e-3);
   EXPECT_NEAR(angleDeg(smoothed.at(41), MotionScript::truth(41)), 0.05 * 1.2, 2e-3);
   EXPECT_NEAR(angleDeg(whole.at(41), MotionScript::truth(41)), 0.05 * 2.0, 2e-3);
+  hubble.angular_velocity_smoothing = 0.0;  // would never learn one
+  expectRefused(hubble, "estimator/angular_velocity_smoothing = 0");
 }
 
 // Hubble hands over to the close-range method at 20 m; the pyramid method gave poses 7 cm off beyond 12 m, so
