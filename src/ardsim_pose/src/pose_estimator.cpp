@@ -37,15 +37,14 @@ double medianOfValues(std::vector<double> values) {
 }  // namespace
 
 void validate(const EstimatorOptions& o) {
-  if (o.median_window < 1 || o.median_window > 51 || o.median_window % 2 == 0)
-    throw std::invalid_argument("median_window = " + std::to_string(o.median_window) +
-                                " is out of range: odd, 1 .. 51");
-  requireOption(o.velocity_smoothing > 0.0 && o.velocity_smoothing <= 1.0, "velocity_smoothing",
+  requireOption(o.median_window >= 1 && o.median_window <= 51 && o.median_window % 2 == 1,
+                "estimator/median_window", o.median_window, "odd, 1 .. 51");
+  requireOption(o.velocity_smoothing > 0.0 && o.velocity_smoothing <= 1.0, "estimator/velocity_smoothing",
                 o.velocity_smoothing, "> 0 .. 1");
   requireOption(o.angular_velocity_smoothing > 0.0 && o.angular_velocity_smoothing <= 1.0,
                 "estimator/angular_velocity_smoothing", o.angular_velocity_smoothing, "> 0 .. 1");
   requireOption(std::isfinite(o.max_prediction_gap_s) && o.max_prediction_gap_s >= 0.0,
-                "max_prediction_gap_s", o.max_prediction_gap_s, ">= 0");
+                "estimator/max_prediction_gap_s", o.max_prediction_gap_s, ">= 0");
   const bool composite_off = o.composite_min_port_range_m == 0.0 && o.composite_max_port_range_m == 0.0;
   requireOption(
       composite_off || (o.composite_min_port_range_m >= 0.0 && o.composite_min_port_range_m <= 1000.0),

@@ -494,6 +494,19 @@ TEST(PoseEstimatorComposite, OutsideItsBandTheSelectedMethodAlone) {
   EXPECT_EQ(ring_probe->calls, 0);
 }
 
+// Each filter option out of range stops the node naming it as the node reads it (its estimator/ prefix).
+TEST(PoseEstimatorOptions, OutOfRangeFilterOptionsAreRefusedByName) {
+  EstimatorOptions options;
+  options.median_window = 4;
+  expectRefused(options, "estimator/median_window = 4");
+  options = EstimatorOptions();
+  options.velocity_smoothing = 1.5;
+  expectRefused(options, "estimator/velocity_smoothing = 1.5");
+  options = EstimatorOptions();
+  options.max_prediction_gap_s = -1.0;
+  expectRefused(options, "estimator/max_prediction_gap_s = -1");
+}
+
 TEST(PoseEstimatorComposite, BadBandOrMissingMethodIsRefused) {
   EstimatorOptions options;
   options.composite_min_port_range_m = 30.0;
