@@ -135,11 +135,18 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
   auto icp = std::make_unique<IcpTracker>(model, ardsim_lidar::intrinsicsFor(config.sensor), config.icp,
                                           config.visibility);
   if (config.panels.enabled) {
-    icp->trackPanels(
-        std::make_unique<PanelTracker>(panelJoint(config.target), config.panels, std::move(model),
-                                       [target = config.target, options = config.model](double angle_rad) {
-                                         return buildReferenceModelWithPanels(target, options, angle_rad);
-                                       }));
+    // The panels are sampled once, at the first angle measured; later angles turn the model before
+    // (ReferenceModel::withArticulatedTurned: a rebuild costs its frame 1-4 ms, not 70-270).
+    const PanelJoint joint = panelJoint(config.target);
+    icp->trackPanels(std::make_unique<PanelTracker>(
+        joint, config.panels, std::move(model),
+        [target = config.target, options = config.model, joint,
+         last = std::shared_ptr<const ReferenceModel>(), last_angle_rad = 0.0](double angle_rad) mutable {
+          last = last ? last->withArticulatedTurned(joint.origin, joint.axis, angle_rad - last_angle_rad)
+                      : buildReferenceModelWithPanels(target, options, angle_rad);
+          last_angle_rad = angle_rad;
+          return last;
+        }));
   }
   methods[EstimateMethod::kIcp] = std::move(icp);
   const close_range::AdapterGeometry geometry = close_range::adapterGeometry(config.target);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -83,6 +85,33 @@ struct ReferenceModel::KdTree {
   }
 };
 
+// The trees of a model with parts that turn (and of every model turned from it): the rigid points, and the
+// articulated ones where they were sampled (with their normals there), each with the model's index of every
+// point.
+struct ReferenceModel::SplitTrees {
+  struct Group {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<std::uint32_t> model_index;
+    std::unique_ptr<KdTree> tree;
+  };
+  Group rigid, articulated;
+  std::vector<Eigen::Vector3f> articulated_normals;
+  // The arrays of the last turned model gone, for the next turn to copy into: allocated anew (~11 MB for
+  // Hubble) they cost one turn in three ~30 ms of page faults. One set: a turn needs one while the model
+  // before it is still in use.
+  struct Arrays {
+    std::vector<Eigen::Vector3f> points, normals;
+    std::vector<float> spacing;
+    std::array<Eigen::ArrayXf, 3> coordinates, patch_centres, patch_normals;
+    Eigen::ArrayXf patch_radii;
+    std::vector<Patch> patches;
+    std::vector<std::uint8_t> patch_articulated;
+    std::vector<Chunk> chunks;
+  };
+  mutable std::mutex spare_mutex;
+  mutable std::optional<Arrays> spare;
+};
+
 namespace {
 
 // nanoflann result set keeping the nearest point that the visibility mask lets through: the model is cropped
@@ -107,9 +136,9 @@ struct NearestVisibleResult {
 struct AnyWithinResult {
   float reach_sq;  // just above the distance squared: the tree passes only points strictly nearer
   bool found = false;
-  bool addPoint(float, std::uint32_t) {
-    found = true;
-    return false;
+  bool addPoint(float distance_sq, std::uint32_t) {
+    found = distance_sq < reach_sq;
+    return !found;
   }
   float worstDist() const { return reach_sq; }
   bool full() const { return found; }
@@ -138,6 +167,41 @@ struct NeighbourhoodResult {
   }
   float worstDist() const { return reach_sq; }
   bool full() const { return best_index >= 0; }
+};
+
+// A search of one group of the points (ReferenceModel::SplitTrees): its tree's indices made the model's.
+template <class Result>
+struct GroupResult {
+  Result& inner;
+  const std::uint32_t* model_index;
+  bool addPoint(float distance_sq, std::uint32_t index) {
+    return inner.addPoint(distance_sq, model_index[index]);
+  }
+  float worstDist() const { return inner.worstDist(); }
+  bool full() const { return inner.full(); }
+};
+
+// How far the turn of a query and of the points may round their distance apart (coordinates within ~20 m).
+constexpr float kTurnRoundingM = 1e-4f;
+
+// A search of the articulated points where they were sampled, the query turned there: the distances are
+// computed anew to the turned points (as the tree would: every search finds the same nearest point), and
+// the search reaches a hair further, for the rounding of the turn.
+template <class Result>
+struct TurnedResult {
+  Result& inner;
+  const std::uint32_t* model_index;
+  const Eigen::Vector3f* model_points;
+  Eigen::Vector3f query;
+  bool addPoint(float, std::uint32_t index) {
+    const std::uint32_t i = model_index[index];
+    return inner.addPoint(treeDistanceSq(query, model_points[i]), i);
+  }
+  float worstDist() const {
+    const float reach = std::sqrt(inner.worstDist()) + kTurnRoundingM;
+    return reach * reach;
+  }
+  bool full() const { return inner.full(); }
 };
 
 }  // namespace
@@ -247,15 +311,135 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
     for (std::size_t i = 0; i < points_.size(); ++i)
       coordinates_[axis][static_cast<Eigen::Index>(i)] = points_[i][axis];
   }
-  tree_ = std::make_unique<KdTree>(&points_);
+  if (std::find(patch_articulated_.begin(), patch_articulated_.end(), 1) == patch_articulated_.end()) {
+    tree_ = std::make_unique<KdTree>(&points_);
+    return;
+  }
+  auto split = std::make_shared<SplitTrees>();
+  for (std::size_t p = 0; p < patches_.size(); ++p) {
+    SplitTrees::Group& group = patch_articulated_[p] ? split->articulated : split->rigid;
+    for (std::uint32_t i = patches_[p].begin; i < patches_[p].end; ++i) {
+      group.points.push_back(points_[i]);
+      group.model_index.push_back(i);
+      if (patch_articulated_[p]) split->articulated_normals.push_back(normals_[i]);
+    }
+  }
+  split->rigid.tree = std::make_unique<KdTree>(&split->rigid.points);
+  split->articulated.tree = std::make_unique<KdTree>(&split->articulated.points);
+  split_ = std::move(split);
 }
 
-ReferenceModel::~ReferenceModel() = default;
+ReferenceModel::~ReferenceModel() {
+  if (!split_) return;
+  SplitTrees::Arrays arrays{std::move(points_),      std::move(normals_),       std::move(spacing_),
+                            std::move(coordinates_), std::move(patch_centres_), std::move(patch_normals_),
+                            std::move(patch_radii_), std::move(patches_),       std::move(patch_articulated_),
+                            std::move(chunks_)};
+  const std::lock_guard<std::mutex> lock(split_->spare_mutex);
+  split_->spare = std::move(arrays);
+}
+
+std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(const Eigen::Vector3d& origin,
+                                                                            const Eigen::Vector3d& axis,
+                                                                            double angle_rad) const {
+  std::shared_ptr<ReferenceModel> turned(new ReferenceModel());
+  ReferenceModel& m = *turned;
+  if (split_) {
+    const std::lock_guard<std::mutex> lock(split_->spare_mutex);
+    if (split_->spare) {
+      SplitTrees::Arrays& spare = *split_->spare;
+      m.points_ = std::move(spare.points);
+      m.normals_ = std::move(spare.normals);
+      m.spacing_ = std::move(spare.spacing);
+      m.coordinates_ = std::move(spare.coordinates);
+      m.patch_centres_ = std::move(spare.patch_centres);
+      m.patch_normals_ = std::move(spare.patch_normals);
+      m.patch_radii_ = std::move(spare.patch_radii);
+      m.patches_ = std::move(spare.patches);
+      m.patch_articulated_ = std::move(spare.patch_articulated);
+      m.chunks_ = std::move(spare.chunks);
+      split_->spare.reset();
+    }
+  }
+  // Copied into the spare's memory when there is one (the sizes are the same).
+  m.points_ = points_;
+  m.normals_ = normals_;
+  m.spacing_ = spacing_;
+  m.coordinates_ = coordinates_;
+  m.patch_centres_ = patch_centres_;
+  m.patch_normals_ = patch_normals_;
+  m.patch_radii_ = patch_radii_;
+  m.patches_ = patches_;
+  m.patch_articulated_ = patch_articulated_;
+  m.chunks_ = chunks_;
+  m.split_ = split_;
+  m.T_model_sampled_ = Eigen::Translation3d(origin) * Eigen::AngleAxisd(angle_rad, axis) *
+                       Eigen::Translation3d(-origin) * T_model_sampled_;
+  m.T_sampled_model_ = m.T_model_sampled_.inverse().cast<float>();
+  if (!split_) {  // nothing turns (the tree reads the points it was built over)
+    m.tree_ = std::make_unique<KdTree>(&m.points_);
+    return turned;
+  }
+  // Turned from where they were sampled (turns do not add up their rounding).
+  const Eigen::Isometry3f T = m.T_model_sampled_.cast<float>();
+  const SplitTrees::Group& articulated = m.split_->articulated;
+  for (std::size_t k = 0; k < articulated.points.size(); ++k) {
+    const std::uint32_t i = articulated.model_index[k];
+    m.points_[i] = T * articulated.points[k];
+    m.normals_[i] = T.linear() * m.split_->articulated_normals[k];
+    for (int axis_index = 0; axis_index < 3; ++axis_index)
+      m.coordinates_[axis_index][i] = m.points_[i][axis_index];
+  }
+  for (Chunk& chunk : m.chunks_) {
+    bool turned_any = false;
+    for (std::uint32_t p = chunk.begin; p < chunk.end; ++p) {
+      if (!m.patch_articulated_[p]) continue;
+      turned_any = true;
+      const Patch& patch = m.patches_[p];
+      // As the constructor bounds a patch: its samples' box, and half a spacing beyond; its normal is its
+      // first sample's.
+      Eigen::AlignedBox3f box;
+      for (std::uint32_t i = patch.begin; i < patch.end; ++i) box.extend(m.points_[i]);
+      const Eigen::Vector3f centre = box.center();
+      for (int axis_index = 0; axis_index < 3; ++axis_index) {
+        m.patch_centres_[axis_index][p] = centre[axis_index];
+        m.patch_normals_[axis_index][p] = m.normals_[patch.begin][axis_index];
+      }
+      m.patch_radii_[p] = 0.5f * box.diagonal().norm() + 0.5f * m.spacing_[patch.begin];
+    }
+    if (!turned_any) continue;
+    Eigen::AlignedBox3f chunk_box;
+    for (std::uint32_t i = m.patches_[chunk.begin].begin; i < m.patches_[chunk.end - 1].end; ++i)
+      chunk_box.extend(m.points_[i]);
+    chunk.centre = chunk_box.center();
+    chunk.radius = 0.5f * chunk_box.diagonal().norm();
+  }
+  return turned;
+}
+
+template <class Result>
+void ReferenceModel::searchRigid(Result& result, const Eigen::Vector3f& query) const {
+  if (tree_) {
+    tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
+    return;
+  }
+  GroupResult<Result> group{result, split_->rigid.model_index.data()};
+  split_->rigid.tree->index.findNeighbors(group, query.data(), nanoflann::SearchParams());
+}
+
+template <class Result>
+void ReferenceModel::searchTurned(Result& result, const Eigen::Vector3f& query) const {
+  if (!split_) return;
+  TurnedResult<Result> turned{result, split_->articulated.model_index.data(), points_.data(), query};
+  const Eigen::Vector3f query_sampled = T_sampled_model_ * query;
+  split_->articulated.tree->index.findNeighbors(turned, query_sampled.data(), nanoflann::SearchParams());
+}
 
 int ReferenceModel::nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
                                    const std::vector<std::uint8_t>& visible, float* distance_sq) const {
   NearestVisibleResult result{visible.data(), max_distance_sq};
-  tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  searchRigid(result, query);
+  searchTurned(result, query);
   *distance_sq = result.best_distance_sq;
   return static_cast<int>(result.best_index);
 }
@@ -267,7 +451,8 @@ int ReferenceModel::nearestVisibleWithNeighbours(const Eigen::Vector3f& query, f
   thread_local std::vector<std::pair<float, std::uint32_t>> found;
   found.clear();
   NeighbourhoodResult result{visible.data(), max_distance_sq, margin_m, &found};
-  tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  searchRigid(result, query);
+  searchTurned(result, query);
   // Points collected while the reach was still wider lie beyond the final ball: left out, it is exact.
   for (const auto& [d, index] : found)
     if (d < result.reach_sq) near->push_back(index);
@@ -278,7 +463,8 @@ int ReferenceModel::nearestVisibleWithNeighbours(const Eigen::Vector3f& query, f
 
 bool ReferenceModel::anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const {
   AnyWithinResult result{std::nextafter(max_distance_sq, std::numeric_limits<float>::infinity())};
-  tree_->index.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  searchRigid(result, query);
+  if (!result.found) searchTurned(result, query);
   return result.found;
 }
 

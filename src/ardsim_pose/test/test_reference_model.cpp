@@ -1,6 +1,7 @@
 // The visible-point grid against the KD-tree it stands in front of: where it answers, the same nearest
 // visible point and a ball that holds every visible point within its radius; and it answers most queries
 // near the surface (what makes it worth building). The patches of parts that turn are flagged.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -10,6 +11,7 @@
 
 #include "ardsim_pose/estimator_factory.h"
 #include "ardsim_pose/evaluation.h"
+#include "ardsim_pose/panel_angle.h"
 #include "ardsim_pose/reference_model.h"
 
 namespace ardsim_pose {
@@ -120,6 +122,131 @@ TEST(ReferenceModelPatches, ThoseOfPartsThatTurnAreFlagged) {
     articulated += flagged ? 1 : 0;
   }
   EXPECT_GT(articulated, 100);
+}
+
+// Hubble's arrays sampled at 30 deg and turned 5 deg about their mast lie where arrays sampled at 35 deg
+// do (turned the other way they do not); the rest stays where it was, and every patch's and chunk's bounds
+// still hold their samples (the visibility prediction splats and culls by them).
+TEST(ReferenceModelPatches, ArticulatedPartsTurnedLieWhereSampledAtThatAngle) {
+  const PoseConfig config;
+  const PanelJoint joint = panelJoint(TargetKind::kHubble);
+  const double degree = M_PI / 180.0;
+  const std::shared_ptr<const ReferenceModel> at30 =
+      buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 30.0 * degree);
+  const std::shared_ptr<const ReferenceModel> at35 =
+      buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 35.0 * degree);
+  const std::shared_ptr<const ReferenceModel> turned =
+      at30->withArticulatedTurned(joint.origin, joint.axis, 5.0 * degree);
+  const std::shared_ptr<const ReferenceModel> turned_back =
+      at30->withArticulatedTurned(joint.origin, joint.axis, -5.0 * degree);
+  ASSERT_EQ(turned->size(), at30->size());
+  ASSERT_EQ(turned->patches().size(), at30->patches().size());
+  const std::vector<std::uint8_t> all(at35->size(), 1);
+  int articulated_points = 0, far_when_turned_back = 0;
+  for (std::uint32_t k = 0; k < turned->patches().size(); ++k) {
+    const ReferenceModel::Patch& patch = turned->patches()[k];
+    const Eigen::Vector3f centre(turned->patchCentres(0)[k], turned->patchCentres(1)[k],
+                                 turned->patchCentres(2)[k]);
+    for (std::uint32_t j = patch.begin; j < patch.end; ++j) {
+      const Eigen::Vector3f& p = turned->points()[j];
+      ASSERT_LE((p - centre).norm(), turned->patchRadii()[k] + 1e-5f) << "patch " << k;
+      if (!turned->patchArticulated(k)) {
+        ASSERT_EQ(p, at30->points()[j]);
+        continue;
+      }
+      ++articulated_points;
+      // Within the sampling's spacing of the arrays sampled at 35 deg (the samples differ, the surface not).
+      float distance_sq = 0.0f;
+      ASSERT_GE(at35->nearestVisible(p, 1.0f, all, &distance_sq), 0);
+      ASSERT_LT(std::sqrt(distance_sq), 0.75f * turned->spacing()[j] + 0.01f) << "point " << j;
+      const float normal_dot =
+          turned->normals()[j].dot(at35->normals()[at35->nearestVisible(p, 1.0f, all, &distance_sq)]);
+      ASSERT_GT(std::abs(normal_dot), 0.999f);
+      float back_sq = 0.0f;
+      if (at35->nearestVisible(turned_back->points()[j], 1.0f, all, &back_sq) < 0 ||
+          std::sqrt(back_sq) > 0.1f)
+        ++far_when_turned_back;
+    }
+  }
+  EXPECT_GT(articulated_points, 1000);
+  EXPECT_GT(far_when_turned_back, articulated_points / 2);
+  for (const ReferenceModel::Chunk& chunk : turned->chunks()) {
+    for (std::uint32_t k = chunk.begin; k < chunk.end; ++k) {
+      const ReferenceModel::Patch& patch = turned->patches()[k];
+      for (std::uint32_t j = patch.begin; j < patch.end; ++j)
+        ASSERT_LE((turned->points()[j] - chunk.centre).norm(), chunk.radius + 1e-5f);
+    }
+  }
+}
+
+// A turned model's searches (its trees built where the points were sampled, queries turned there) find
+// what a search of every turned point finds: the same nearest visible point at the same distance, and
+// anyWithin agrees; turned twice is turned once by the sum.
+TEST(ReferenceModelPatches, TurnedModelsSearchesFindTheNearestTurnedPoint) {
+  const PoseConfig config;
+  const PanelJoint joint = panelJoint(TargetKind::kHubble);
+  const double degree = M_PI / 180.0;
+  const std::shared_ptr<const ReferenceModel> sampled =
+      buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 30.0 * degree);
+  const std::shared_ptr<const ReferenceModel> once =
+      sampled->withArticulatedTurned(joint.origin, joint.axis, 2.0 * degree);
+  const std::shared_ptr<const ReferenceModel> twice =
+      once->withArticulatedTurned(joint.origin, joint.axis, 3.0 * degree);
+  const std::shared_ptr<const ReferenceModel> at_sum =
+      sampled->withArticulatedTurned(joint.origin, joint.axis, 5.0 * degree);
+  for (std::size_t j = 0; j < twice->size(); ++j)
+    ASSERT_LT((twice->points()[j] - at_sum->points()[j]).norm(), 1e-5f);
+  // A turn into the memory of a turned model gone is the same turn.
+  sampled->withArticulatedTurned(joint.origin, joint.axis, -7.0 * degree).reset();
+  const std::shared_ptr<const ReferenceModel> reusing =
+      sampled->withArticulatedTurned(joint.origin, joint.axis, 5.0 * degree);
+  ASSERT_EQ(reusing->points(), at_sum->points());
+  ASSERT_EQ(reusing->normals(), at_sum->normals());
+  ASSERT_TRUE((reusing->patchRadii() == at_sum->patchRadii()).all());
+  ASSERT_TRUE((reusing->patchNormals(2) == at_sum->patchNormals(2)).all());
+
+  std::mt19937 random(7);
+  std::uniform_int_distribution<std::size_t> pick(0, twice->size() - 1);
+  std::normal_distribution<float> offset(0.0f, 0.05f);
+  std::bernoulli_distribution coin(0.7);
+  std::vector<std::uint8_t> visible(twice->size());
+  for (auto& v : visible) v = coin(random) ? 1 : 0;
+  const float gate_sq = 0.2f * 0.2f;
+  int found_articulated = 0;
+  for (int n = 0; n < 2000; ++n) {
+    const Eigen::Vector3f query =
+        twice->points()[pick(random)] + Eigen::Vector3f(offset(random), offset(random), offset(random));
+    int expected = -1;
+    float expected_sq = gate_sq;
+    float nearest_any_sq = gate_sq;  // visible or not
+    for (std::size_t j = 0; j < twice->size(); ++j) {
+      const float d = twice->distanceSq(query, static_cast<std::uint32_t>(j));
+      nearest_any_sq = std::min(nearest_any_sq, d);
+      if (visible[j] && d < expected_sq) {
+        expected_sq = d;
+        expected = static_cast<int>(j);
+      }
+    }
+    EXPECT_TRUE(twice->anyWithin(query, nearest_any_sq));
+    EXPECT_FALSE(twice->anyWithin(query, 0.99f * nearest_any_sq));
+    float distance_sq = 0.0f;
+    const int found = twice->nearestVisible(query, gate_sq, visible, &distance_sq);
+    ASSERT_EQ(found, expected) << "query " << n;
+    if (found < 0) continue;
+    ASSERT_EQ(distance_sq, expected_sq);
+    float radius_m = 0.0f;
+    std::vector<std::uint32_t> near;
+    ASSERT_EQ(
+        twice->nearestVisibleWithNeighbours(query, gate_sq, visible, 0.02f, &distance_sq, &radius_m, &near),
+        expected);
+    ASSERT_NE(std::find(near.begin(), near.end(), static_cast<std::uint32_t>(expected)), near.end());
+    const std::uint32_t patch_of_found = static_cast<std::uint32_t>(
+        std::upper_bound(twice->patches().begin(), twice->patches().end(), static_cast<std::uint32_t>(found),
+                         [](std::uint32_t i, const ReferenceModel::Patch& p) { return i < p.end; }) -
+        twice->patches().begin());
+    if (twice->patchArticulated(patch_of_found)) ++found_articulated;
+  }
+  EXPECT_GT(found_articulated, 200);
 }
 
 }  // namespace

@@ -52,11 +52,11 @@ struct PanelOptions {
   // The model is rebuilt with the panels at that median when it differs from the model's angle by more
   // than this: a model panel 2 deg off tilted Hubble's estimate 0.15-0.4 deg (a rotation about the mast
   // axis is a pitch of the whole body to ICP). The fits, made at the estimated pose, follow that pitch back
-  // towards the model's angle, so a first angle up to ~0.1 deg off can stay (a slow approach, 51 -> 46 m in
-  // 5 cm steps: the body 0.03-0.05 deg off, 30-50 m attitude RMS 0.041 deg; 0.022 with 0.03); but each
-  // rebuild costs its frame 70-270 ms, and 0.03 put 121 of hubble_hold_arrays30's 7001 frames over 50 ms
-  // (p99 16 -> 125 ms) for 0.023 -> 0.017 deg there.
-  double rebuild_deg = 0.1;
+  // towards the model's angle, so a first angle ~0.1 deg off stayed with 0.1 here (a slow approach, 51 ->
+  // 46 m in 5 cm steps: the body 0.03-0.05 deg off, 30-50 m attitude RMS 0.041 deg; 0.022 with 0.03). A
+  // rebuild turns the panels' samples (ReferenceModel::withArticulatedTurned, 1-4 ms); sampled anew
+  // (70-270 ms) 0.03 put 121 of hubble_hold_arrays30's 7001 frames over 50 ms.
+  double rebuild_deg = 0.03;
 };
 void validate(const PanelOptions& options);
 
