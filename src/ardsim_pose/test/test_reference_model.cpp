@@ -124,21 +124,23 @@ TEST(ReferenceModelPatches, ThoseOfPartsThatTurnAreFlagged) {
   EXPECT_GT(articulated, 100);
 }
 
+// Hubble's model with its arrays sampled at angle_deg, and a model's arrays turned by turn_deg.
+std::shared_ptr<const ReferenceModel> hubbleWithArraysAt(double angle_deg) {
+  return buildReferenceModelWithPanels(TargetKind::kHubble, PoseConfig().model, angle_deg * M_PI / 180.0);
+}
+std::shared_ptr<const ReferenceModel> turnedArrays(const ReferenceModel& model, double turn_deg) {
+  const PanelJoint joint = panelJoint(TargetKind::kHubble);
+  return model.withArticulatedTurned(joint.origin, joint.axis, turn_deg * M_PI / 180.0);
+}
+
 // Hubble's arrays sampled at 30 deg and turned 5 deg about their mast lie where arrays sampled at 35 deg
 // do (turned the other way they do not); the rest stays where it was, and every patch's and chunk's bounds
 // still hold their samples (the visibility prediction splats and culls by them).
 TEST(ReferenceModelPatches, ArticulatedPartsTurnedLieWhereSampledAtThatAngle) {
-  const PoseConfig config;
-  const PanelJoint joint = panelJoint(TargetKind::kHubble);
-  const double degree = M_PI / 180.0;
-  const std::shared_ptr<const ReferenceModel> at30 =
-      buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 30.0 * degree);
-  const std::shared_ptr<const ReferenceModel> at35 =
-      buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 35.0 * degree);
-  const std::shared_ptr<const ReferenceModel> turned =
-      at30->withArticulatedTurned(joint.origin, joint.axis, 5.0 * degree);
-  const std::shared_ptr<const ReferenceModel> turned_back =
-      at30->withArticulatedTurned(joint.origin, joint.axis, -5.0 * degree);
+  const std::shared_ptr<const ReferenceModel> at30 = hubbleWithArraysAt(30.0);
+  const std::shared_ptr<const ReferenceModel> at35 = hubbleWithArraysAt(35.0);
+  const std::shared_ptr<const ReferenceModel> turned = turnedArrays(*at30, 5.0);
+  const std::shared_ptr<const ReferenceModel> turned_back = turnedArrays(*at30, -5.0);
   ASSERT_EQ(turned->size(), at30->size());
   ASSERT_EQ(turned->patches().size(), at30->patches().size());
   const std::vector<std::uint8_t> all(at35->size(), 1);
@@ -183,23 +185,15 @@ TEST(ReferenceModelPatches, ArticulatedPartsTurnedLieWhereSampledAtThatAngle) {
 // what a search of every turned point finds: the same nearest visible point at the same distance, and
 // anyWithin agrees; turned twice is turned once by the sum.
 TEST(ReferenceModelPatches, TurnedModelsSearchesFindTheNearestTurnedPoint) {
-  const PoseConfig config;
-  const PanelJoint joint = panelJoint(TargetKind::kHubble);
-  const double degree = M_PI / 180.0;
-  const std::shared_ptr<const ReferenceModel> sampled =
-      buildReferenceModelWithPanels(TargetKind::kHubble, config.model, 30.0 * degree);
-  const std::shared_ptr<const ReferenceModel> once =
-      sampled->withArticulatedTurned(joint.origin, joint.axis, 2.0 * degree);
-  const std::shared_ptr<const ReferenceModel> twice =
-      once->withArticulatedTurned(joint.origin, joint.axis, 3.0 * degree);
-  const std::shared_ptr<const ReferenceModel> at_sum =
-      sampled->withArticulatedTurned(joint.origin, joint.axis, 5.0 * degree);
+  const std::shared_ptr<const ReferenceModel> sampled = hubbleWithArraysAt(30.0);
+  const std::shared_ptr<const ReferenceModel> once = turnedArrays(*sampled, 2.0);
+  const std::shared_ptr<const ReferenceModel> twice = turnedArrays(*once, 3.0);
+  const std::shared_ptr<const ReferenceModel> at_sum = turnedArrays(*sampled, 5.0);
   for (std::size_t j = 0; j < twice->size(); ++j)
     ASSERT_LT((twice->points()[j] - at_sum->points()[j]).norm(), 1e-5f);
   // A turn into the memory of a turned model gone is the same turn.
-  sampled->withArticulatedTurned(joint.origin, joint.axis, -7.0 * degree).reset();
-  const std::shared_ptr<const ReferenceModel> reusing =
-      sampled->withArticulatedTurned(joint.origin, joint.axis, 5.0 * degree);
+  turnedArrays(*sampled, -7.0).reset();
+  const std::shared_ptr<const ReferenceModel> reusing = turnedArrays(*sampled, 5.0);
   ASSERT_EQ(reusing->points(), at_sum->points());
   ASSERT_EQ(reusing->normals(), at_sum->normals());
   ASSERT_TRUE((reusing->patchRadii() == at_sum->patchRadii()).all());
