@@ -105,7 +105,7 @@ struct ReferenceModel::SplitTrees {
     std::array<Eigen::ArrayXf, 3> coordinates, patch_centres, patch_normals;
     Eigen::ArrayXf patch_radii;
     std::vector<Patch> patches;
-    std::vector<std::uint8_t> patch_articulated;
+    std::vector<std::uint8_t> patch_articulated, point_articulated;
     std::vector<Chunk> chunks;
   };
   mutable std::mutex spare_mutex;
@@ -311,6 +311,10 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
     for (std::size_t i = 0; i < points_.size(); ++i)
       coordinates_[axis][static_cast<Eigen::Index>(i)] = points_[i][axis];
   }
+  point_articulated_.resize(points_.size());
+  for (std::size_t p = 0; p < patches_.size(); ++p)
+    std::fill(point_articulated_.begin() + patches_[p].begin, point_articulated_.begin() + patches_[p].end,
+              patch_articulated_[p]);
   if (std::find(patch_articulated_.begin(), patch_articulated_.end(), 1) == patch_articulated_.end()) {
     tree_ = std::make_unique<KdTree>(&points_);
     return;
@@ -331,9 +335,16 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
 
 ReferenceModel::~ReferenceModel() {
   if (!split_) return;
-  SplitTrees::Arrays arrays{std::move(points_),      std::move(normals_),       std::move(spacing_),
-                            std::move(coordinates_), std::move(patch_centres_), std::move(patch_normals_),
-                            std::move(patch_radii_), std::move(patches_),       std::move(patch_articulated_),
+  SplitTrees::Arrays arrays{std::move(points_),
+                            std::move(normals_),
+                            std::move(spacing_),
+                            std::move(coordinates_),
+                            std::move(patch_centres_),
+                            std::move(patch_normals_),
+                            std::move(patch_radii_),
+                            std::move(patches_),
+                            std::move(patch_articulated_),
+                            std::move(point_articulated_),
                             std::move(chunks_)};
   const std::lock_guard<std::mutex> lock(split_->spare_mutex);
   split_->spare = std::move(arrays);
@@ -357,6 +368,7 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
       m.patch_radii_ = std::move(spare.patch_radii);
       m.patches_ = std::move(spare.patches);
       m.patch_articulated_ = std::move(spare.patch_articulated);
+      m.point_articulated_ = std::move(spare.point_articulated);
       m.chunks_ = std::move(spare.chunks);
       split_->spare.reset();
     }
@@ -371,6 +383,7 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
   m.patch_radii_ = patch_radii_;
   m.patches_ = patches_;
   m.patch_articulated_ = patch_articulated_;
+  m.point_articulated_ = point_articulated_;
   m.chunks_ = chunks_;
   m.split_ = split_;
   m.T_model_sampled_ = Eigen::Translation3d(origin) * Eigen::AngleAxisd(angle_rad, axis) *

@@ -1,5 +1,5 @@
-// A target along its docking axis, rendered with noise by the lidar core in-process, through an estimator
-// from the first frame's truth: the rendered tests' approaches, frame by frame.
+// A target along its docking axis, rendered (with noise, by default) by the lidar core in-process, through an
+// estimator from the first frame's truth: the rendered tests' approaches, frame by frame.
 #pragma once
 
 #include <cstdint>
@@ -17,10 +17,11 @@ class AlongTheDockingAxis {
  public:
   // config: the estimator's (its target's kind and sensor); target: the mesh rendered.
   AlongTheDockingAxis(const PoseConfig& config, const ardsim_description::TriangleMesh& target,
-                      std::uint64_t simulator_seed, double frame_period_s = 0.1)
+                      std::uint64_t simulator_seed, double frame_period_s = 0.1,
+                      const ardsim_lidar::NoiseOptions& noise = {})
       : config_(config),
         frame_period_s_(frame_period_s),
-        simulator_(config.sensor, ardsim_lidar::NoiseOptions{}, simulator_seed),
+        simulator_(config.sensor, noise, simulator_seed),
         estimator_(makeEstimator(config)) {
     simulator_.setTarget(target);
   }

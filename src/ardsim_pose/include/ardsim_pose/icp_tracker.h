@@ -271,6 +271,8 @@ class IcpTracker : public PoseMethod {
       acquired_;  // (stamp s, pose) of the last acquisition frames
   double coverage_ = 0.0;
   std::vector<Eigen::Vector3f> scan_;
+  // Per scan_ point: its pixel is an edge of a surface at least three pixels across (see align()).
+  std::vector<std::uint8_t> scan_on_wide_edge_;
   std::vector<int> active_;  // indices of the scan_ points still searched for
   // Per scan_ point, the visible model points in a ball around where it was last searched (target frame):
   // while it stays well inside that ball, its nearest visible model point is among them (exact, and most

@@ -102,6 +102,8 @@ class ReferenceModel {
   // Whether a patch is of a part that turns (ardsim_description::Part::articulated: Hubble's arrays, in the
   // model at the angle the scans measure): where it ends is only as good as that angle.
   bool patchArticulated(std::uint32_t patch) const { return patch_articulated_[patch] != 0; }
+  // Whether a point is of a part that turns (its patch's flag, per point).
+  bool pointArticulated(std::uint32_t point) const { return point_articulated_[point] != 0; }
   // The patches' centres, normals (axis 0-2) and radii as arrays (vectorized per chunk).
   const Eigen::ArrayXf& patchCentres(int axis) const { return patch_centres_[axis]; }
   const Eigen::ArrayXf& patchNormals(int axis) const { return patch_normals_[axis]; }
@@ -126,6 +128,7 @@ class ReferenceModel {
   Eigen::ArrayXf patch_radii_;
   std::vector<Patch> patches_;
   std::vector<std::uint8_t> patch_articulated_;  // beside patches_: their loops read begin and end only
+  std::vector<std::uint8_t> point_articulated_;
   std::vector<Chunk> chunks_;
   // One tree over every point, or with parts that turn split_, shared by the models turned from one another.
   std::unique_ptr<KdTree> tree_;
