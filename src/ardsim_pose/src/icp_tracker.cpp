@@ -571,15 +571,15 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       float distance_sq = 0.0f;
       const int j = nearestVisible(k, T_target_lidar * s, gate_sq, &distance_sq);
       if (j < 0) continue;
+      // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
+      // solar arrays, background returns. Searching for it again each iteration is the costliest query.
+      if (tracking) active_[kept++] = k;
       // The edge rows of a turned array (Hubble's, 4 cm thick, seen obliquely) return ~2 cm off the model's
       // planes, one whole pixel row at once where the edge lies along it: with their ~6 m levers they turned
       // the estimate 0.03-0.06 deg about the arrays' in-plane axis over a 0.7 m window of range (noise-free
       // renders at 49 m). Such pixels do not count against a part that turns; thin structures (masts, booms:
       // 1-2 pixels) and the rigid parts' edges do.
       if (scan_on_wide_edge_[k] && model_->pointArticulated(static_cast<std::uint32_t>(j))) continue;
-      // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
-      // solar arrays, background returns. Searching for it again each iteration is the costliest query.
-      if (tracking) active_[kept++] = k;
       Correspondence c;
       c.scan = s.cast<double>();
       c.model = T * model_->points()[j].cast<double>();
@@ -928,10 +928,11 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
       std::min<std::size_t>(gated_.size(), near ? options_.max_points_near : options_.max_points);
   scan_.reserve(count);
   scan_on_wide_edge_.clear();
+  const bool parts_turn = model_->hasArticulatedParts();  // the edge flags matter only against those
   for (std::size_t k = 0; k < count; ++k) {
     const int i = gated_[k * gated_.size() / count];
     scan_.push_back(cloud.points[i]);
-    scan_on_wide_edge_.push_back(onWideEdge(cloud, i % cloud.width, i / cloud.width) ? 1 : 0);
+    scan_on_wide_edge_.push_back(parts_turn && onWideEdge(cloud, i % cloud.width, i / cloud.width) ? 1 : 0);
   }
 
   cloud_ = &cloud;

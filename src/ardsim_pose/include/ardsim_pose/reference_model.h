@@ -102,6 +102,7 @@ class ReferenceModel {
   // Whether a patch is of a part that turns (ardsim_description::Part::articulated: Hubble's arrays, in the
   // model at the angle the scans measure): where it ends is only as good as that angle.
   bool patchArticulated(std::uint32_t patch) const { return patch_articulated_[patch] != 0; }
+  bool hasArticulatedParts() const { return split_ != nullptr; }
   // Whether a point is of a part that turns (its patch's flag, per point).
   bool pointArticulated(std::uint32_t point) const { return point_articulated_[point] != 0; }
   // The patches' centres, normals (axis 0-2) and radii as arrays (vectorized per chunk).
