@@ -99,17 +99,8 @@ struct ReferenceModel::SplitTrees {
   // The arrays of the last turned model gone, for the next turn to copy into: allocated anew (~11 MB for
   // Hubble) they cost one turn in three ~30 ms of page faults. One set: a turn needs one while the model
   // before it is still in use.
-  struct Arrays {
-    std::vector<Eigen::Vector3f> points, normals;
-    std::vector<float> spacing;
-    std::array<Eigen::ArrayXf, 3> coordinates, patch_centres, patch_normals;
-    Eigen::ArrayXf patch_radii;
-    std::vector<Patch> patches;
-    std::vector<std::uint8_t> patch_articulated, point_articulated;
-    std::vector<Chunk> chunks;
-  };
   mutable std::mutex spare_mutex;
-  mutable std::optional<Arrays> spare;
+  mutable std::optional<ReferenceModel::Arrays> spare;
 };
 
 namespace {
@@ -260,72 +251,73 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
                    static_cast<int>(std::floor(p.z() * inv))}]
         .push_back(&patch.second);
   }
-  points_.reserve(points.size());
-  normals_.reserve(points.size());
-  spacing_.reserve(points.size());
+  arrays_.points.reserve(points.size());
+  arrays_.normals.reserve(points.size());
+  arrays_.spacing.reserve(points.size());
   std::vector<Eigen::Vector3f> patch_centres, patch_normals;
   std::vector<float> patch_radii;
   for (const auto& chunk_entry : chunk_members) {
     Chunk chunk;
-    chunk.begin = static_cast<std::uint32_t>(patches_.size());
+    chunk.begin = static_cast<std::uint32_t>(arrays_.patches.size());
     Eigen::AlignedBox3f chunk_box;
     for (const std::vector<std::uint32_t>* members : chunk_entry.second) {
       Patch patch;
-      patch.begin = static_cast<std::uint32_t>(points_.size());
+      patch.begin = static_cast<std::uint32_t>(arrays_.points.size());
       const std::uint32_t triangle = triangle_of[members->front()];
-      patch_articulated_.push_back(triangle < mesh.triangle_part.size() &&
-                                   mesh.triangle_part[triangle] < mesh.parts.size() &&
-                                   mesh.parts[mesh.triangle_part[triangle]].articulated);
+      arrays_.patch_articulated.push_back(triangle < mesh.triangle_part.size() &&
+                                          mesh.triangle_part[triangle] < mesh.parts.size() &&
+                                          mesh.parts[mesh.triangle_part[triangle]].articulated);
       patch_normals.push_back(normals[members->front()]);
       Eigen::AlignedBox3f box;
       for (std::uint32_t i : *members) {
-        points_.push_back(points[i]);
-        normals_.push_back(normals[i]);
-        spacing_.push_back(spacing[i]);
+        arrays_.points.push_back(points[i]);
+        arrays_.normals.push_back(normals[i]);
+        arrays_.spacing.push_back(spacing[i]);
         box.extend(points[i]);
       }
-      patch.end = static_cast<std::uint32_t>(points_.size());
+      patch.end = static_cast<std::uint32_t>(arrays_.points.size());
       patch_centres.push_back(box.center());
       // Half a spacing beyond the outermost samples: the surface the samples stand for.
       patch_radii.push_back(0.5f * box.diagonal().norm() + 0.5f * spacing[members->front()]);
-      patches_.push_back(patch);
+      arrays_.patches.push_back(patch);
       chunk_box.extend(box);
     }
-    chunk.end = static_cast<std::uint32_t>(patches_.size());
+    chunk.end = static_cast<std::uint32_t>(arrays_.patches.size());
     chunk.centre = chunk_box.center();
     chunk.radius = 0.5f * chunk_box.diagonal().norm();
-    chunks_.push_back(chunk);
+    arrays_.chunks.push_back(chunk);
   }
   // Arrays for vectorized loops over ranges of patches and points (the points also stay as vectors: the tree
   // and the ICP read them one at a time).
-  patch_radii_ =
+  arrays_.patch_radii =
       Eigen::Map<const Eigen::ArrayXf>(patch_radii.data(), static_cast<Eigen::Index>(patch_radii.size()));
   for (int axis = 0; axis < 3; ++axis) {
-    patch_centres_[axis].resize(static_cast<Eigen::Index>(patch_centres.size()));
-    patch_normals_[axis].resize(static_cast<Eigen::Index>(patch_normals.size()));
+    arrays_.patch_centres[axis].resize(static_cast<Eigen::Index>(patch_centres.size()));
+    arrays_.patch_normals[axis].resize(static_cast<Eigen::Index>(patch_normals.size()));
     for (std::size_t i = 0; i < patch_centres.size(); ++i) {
-      patch_centres_[axis][static_cast<Eigen::Index>(i)] = patch_centres[i][axis];
-      patch_normals_[axis][static_cast<Eigen::Index>(i)] = patch_normals[i][axis];
+      arrays_.patch_centres[axis][static_cast<Eigen::Index>(i)] = patch_centres[i][axis];
+      arrays_.patch_normals[axis][static_cast<Eigen::Index>(i)] = patch_normals[i][axis];
     }
-    coordinates_[axis].resize(static_cast<Eigen::Index>(points_.size()));
-    for (std::size_t i = 0; i < points_.size(); ++i)
-      coordinates_[axis][static_cast<Eigen::Index>(i)] = points_[i][axis];
+    arrays_.coordinates[axis].resize(static_cast<Eigen::Index>(arrays_.points.size()));
+    for (std::size_t i = 0; i < arrays_.points.size(); ++i)
+      arrays_.coordinates[axis][static_cast<Eigen::Index>(i)] = arrays_.points[i][axis];
   }
-  point_articulated_.resize(points_.size());
-  for (std::size_t p = 0; p < patches_.size(); ++p)
-    std::fill(point_articulated_.begin() + patches_[p].begin, point_articulated_.begin() + patches_[p].end,
-              patch_articulated_[p]);
-  if (std::find(patch_articulated_.begin(), patch_articulated_.end(), 1) == patch_articulated_.end()) {
-    tree_ = std::make_unique<KdTree>(&points_);
+  arrays_.point_articulated.resize(arrays_.points.size());
+  for (std::size_t p = 0; p < arrays_.patches.size(); ++p)
+    std::fill(arrays_.point_articulated.begin() + arrays_.patches[p].begin,
+              arrays_.point_articulated.begin() + arrays_.patches[p].end, arrays_.patch_articulated[p]);
+  if (std::find(arrays_.patch_articulated.begin(), arrays_.patch_articulated.end(), 1) ==
+      arrays_.patch_articulated.end()) {
+    tree_ = std::make_unique<KdTree>(&arrays_.points);
     return;
   }
   auto split = std::make_shared<SplitTrees>();
-  for (std::size_t p = 0; p < patches_.size(); ++p) {
-    SplitTrees::Group& group = patch_articulated_[p] ? split->articulated : split->rigid;
-    for (std::uint32_t i = patches_[p].begin; i < patches_[p].end; ++i) {
-      group.points.push_back(points_[i]);
+  for (std::size_t p = 0; p < arrays_.patches.size(); ++p) {
+    SplitTrees::Group& group = arrays_.patch_articulated[p] ? split->articulated : split->rigid;
+    for (std::uint32_t i = arrays_.patches[p].begin; i < arrays_.patches[p].end; ++i) {
+      group.points.push_back(arrays_.points[i]);
       group.model_index.push_back(i);
-      if (patch_articulated_[p]) split->articulated_normals.push_back(normals_[i]);
+      if (arrays_.patch_articulated[p]) split->articulated_normals.push_back(arrays_.normals[i]);
     }
   }
   split->rigid.tree = std::make_unique<KdTree>(&split->rigid.points);
@@ -335,19 +327,8 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
 
 ReferenceModel::~ReferenceModel() {
   if (!split_) return;
-  SplitTrees::Arrays arrays{std::move(points_),
-                            std::move(normals_),
-                            std::move(spacing_),
-                            std::move(coordinates_),
-                            std::move(patch_centres_),
-                            std::move(patch_normals_),
-                            std::move(patch_radii_),
-                            std::move(patches_),
-                            std::move(patch_articulated_),
-                            std::move(point_articulated_),
-                            std::move(chunks_)};
   const std::lock_guard<std::mutex> lock(split_->spare_mutex);
-  split_->spare = std::move(arrays);
+  split_->spare = std::move(arrays_);
 }
 
 std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(const Eigen::Vector3d& origin,
@@ -358,39 +339,18 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
   if (split_) {
     const std::lock_guard<std::mutex> lock(split_->spare_mutex);
     if (split_->spare) {
-      SplitTrees::Arrays& spare = *split_->spare;
-      m.points_ = std::move(spare.points);
-      m.normals_ = std::move(spare.normals);
-      m.spacing_ = std::move(spare.spacing);
-      m.coordinates_ = std::move(spare.coordinates);
-      m.patch_centres_ = std::move(spare.patch_centres);
-      m.patch_normals_ = std::move(spare.patch_normals);
-      m.patch_radii_ = std::move(spare.patch_radii);
-      m.patches_ = std::move(spare.patches);
-      m.patch_articulated_ = std::move(spare.patch_articulated);
-      m.point_articulated_ = std::move(spare.point_articulated);
-      m.chunks_ = std::move(spare.chunks);
+      m.arrays_ = std::move(*split_->spare);
       split_->spare.reset();
     }
   }
   // Copied into the spare's memory when there is one (the sizes are the same).
-  m.points_ = points_;
-  m.normals_ = normals_;
-  m.spacing_ = spacing_;
-  m.coordinates_ = coordinates_;
-  m.patch_centres_ = patch_centres_;
-  m.patch_normals_ = patch_normals_;
-  m.patch_radii_ = patch_radii_;
-  m.patches_ = patches_;
-  m.patch_articulated_ = patch_articulated_;
-  m.point_articulated_ = point_articulated_;
-  m.chunks_ = chunks_;
+  m.arrays_ = arrays_;
   m.split_ = split_;
   m.T_model_sampled_ = Eigen::Translation3d(origin) * Eigen::AngleAxisd(angle_rad, axis) *
                        Eigen::Translation3d(-origin) * T_model_sampled_;
   m.T_sampled_model_ = m.T_model_sampled_.inverse().cast<float>();
   if (!split_) {  // nothing turns (the tree reads the points it was built over)
-    m.tree_ = std::make_unique<KdTree>(&m.points_);
+    m.tree_ = std::make_unique<KdTree>(&m.arrays_.points);
     return turned;
   }
   // Turned from where they were sampled (turns do not add up their rounding).
@@ -398,32 +358,33 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
   const SplitTrees::Group& articulated = m.split_->articulated;
   for (std::size_t k = 0; k < articulated.points.size(); ++k) {
     const std::uint32_t i = articulated.model_index[k];
-    m.points_[i] = T * articulated.points[k];
-    m.normals_[i] = T.linear() * m.split_->articulated_normals[k];
+    m.arrays_.points[i] = T * articulated.points[k];
+    m.arrays_.normals[i] = T.linear() * m.split_->articulated_normals[k];
     for (int axis_index = 0; axis_index < 3; ++axis_index)
-      m.coordinates_[axis_index][i] = m.points_[i][axis_index];
+      m.arrays_.coordinates[axis_index][i] = m.arrays_.points[i][axis_index];
   }
-  for (Chunk& chunk : m.chunks_) {
+  for (Chunk& chunk : m.arrays_.chunks) {
     bool turned_any = false;
     for (std::uint32_t p = chunk.begin; p < chunk.end; ++p) {
-      if (!m.patch_articulated_[p]) continue;
+      if (!m.arrays_.patch_articulated[p]) continue;
       turned_any = true;
-      const Patch& patch = m.patches_[p];
+      const Patch& patch = m.arrays_.patches[p];
       // As the constructor bounds a patch: its samples' box, and half a spacing beyond; its normal is its
       // first sample's.
       Eigen::AlignedBox3f box;
-      for (std::uint32_t i = patch.begin; i < patch.end; ++i) box.extend(m.points_[i]);
+      for (std::uint32_t i = patch.begin; i < patch.end; ++i) box.extend(m.arrays_.points[i]);
       const Eigen::Vector3f centre = box.center();
       for (int axis_index = 0; axis_index < 3; ++axis_index) {
-        m.patch_centres_[axis_index][p] = centre[axis_index];
-        m.patch_normals_[axis_index][p] = m.normals_[patch.begin][axis_index];
+        m.arrays_.patch_centres[axis_index][p] = centre[axis_index];
+        m.arrays_.patch_normals[axis_index][p] = m.arrays_.normals[patch.begin][axis_index];
       }
-      m.patch_radii_[p] = 0.5f * box.diagonal().norm() + 0.5f * m.spacing_[patch.begin];
+      m.arrays_.patch_radii[p] = 0.5f * box.diagonal().norm() + 0.5f * m.arrays_.spacing[patch.begin];
     }
     if (!turned_any) continue;
     Eigen::AlignedBox3f chunk_box;
-    for (std::uint32_t i = m.patches_[chunk.begin].begin; i < m.patches_[chunk.end - 1].end; ++i)
-      chunk_box.extend(m.points_[i]);
+    for (std::uint32_t i = m.arrays_.patches[chunk.begin].begin; i < m.arrays_.patches[chunk.end - 1].end;
+         ++i)
+      chunk_box.extend(m.arrays_.points[i]);
     chunk.centre = chunk_box.center();
     chunk.radius = 0.5f * chunk_box.diagonal().norm();
   }
@@ -443,7 +404,7 @@ void ReferenceModel::searchRigid(Result& result, const Eigen::Vector3f& query) c
 template <class Result>
 void ReferenceModel::searchTurned(Result& result, const Eigen::Vector3f& query) const {
   if (!split_) return;
-  TurnedResult<Result> turned{result, split_->articulated.model_index.data(), points_.data(), query};
+  TurnedResult<Result> turned{result, split_->articulated.model_index.data(), arrays_.points.data(), query};
   const Eigen::Vector3f query_sampled = T_sampled_model_ * query;
   split_->articulated.tree->index.findNeighbors(turned, query_sampled.data(), nanoflann::SearchParams());
 }

@@ -61,12 +61,12 @@ class ReferenceModel {
                                                               double angle_rad) const;
   ReferenceModel& operator=(const ReferenceModel&) = delete;
 
-  std::size_t size() const { return points_.size(); }
-  const std::vector<Eigen::Vector3f>& points() const { return points_; }    // target frame, m
-  const std::vector<Eigen::Vector3f>& normals() const { return normals_; }  // unit, outward
-  const std::vector<float>& spacing() const { return spacing_; }            // m, per point
+  std::size_t size() const { return arrays_.points.size(); }
+  const std::vector<Eigen::Vector3f>& points() const { return arrays_.points; }    // target frame, m
+  const std::vector<Eigen::Vector3f>& normals() const { return arrays_.normals; }  // unit, outward
+  const std::vector<float>& spacing() const { return arrays_.spacing; }            // m, per point
   // The points' x, y and z coordinates as three arrays (vectorized transforms of ranges of points).
-  const Eigen::ArrayXf& coordinates(int axis) const { return coordinates_[axis]; }
+  const Eigen::ArrayXf& coordinates(int axis) const { return arrays_.coordinates[axis]; }
 
   // Nearest point with visible[index] != 0 within sqrt(max_distance_sq) of query (target frame); -1 if none.
   int nearestVisible(const Eigen::Vector3f& query, float max_distance_sq,
@@ -81,7 +81,7 @@ class ReferenceModel {
                                    std::vector<std::uint32_t>* near) const;
   // Squared distance from query to point index, computed as the tree computes it.
   float distanceSq(const Eigen::Vector3f& query, std::uint32_t index) const {
-    return treeDistanceSq(query, points_[index]);
+    return treeDistanceSq(query, arrays_.points[index]);
   }
   // Whether any model point, visible or not, lies within sqrt(max_distance_sq) of query (target frame).
   bool anyWithin(const Eigen::Vector3f& query, float max_distance_sq) const;
@@ -98,18 +98,18 @@ class ReferenceModel {
     std::uint32_t begin = 0;
     std::uint32_t end = 0;
   };
-  const std::vector<Patch>& patches() const { return patches_; }
+  const std::vector<Patch>& patches() const { return arrays_.patches; }
   // Whether a patch is of a part that turns (ardsim_description::Part::articulated: Hubble's arrays, in the
   // model at the angle the scans measure): where it ends is only as good as that angle.
-  bool patchArticulated(std::uint32_t patch) const { return patch_articulated_[patch] != 0; }
+  bool patchArticulated(std::uint32_t patch) const { return arrays_.patch_articulated[patch] != 0; }
   bool hasArticulatedParts() const { return split_ != nullptr; }
   // Whether a point is of a part that turns (its patch's flag, per point).
-  bool pointArticulated(std::uint32_t point) const { return point_articulated_[point] != 0; }
+  bool pointArticulated(std::uint32_t point) const { return arrays_.point_articulated[point] != 0; }
   // The patches' centres, normals (axis 0-2) and radii as arrays (vectorized per chunk).
-  const Eigen::ArrayXf& patchCentres(int axis) const { return patch_centres_[axis]; }
-  const Eigen::ArrayXf& patchNormals(int axis) const { return patch_normals_[axis]; }
-  const Eigen::ArrayXf& patchRadii() const { return patch_radii_; }
-  const std::vector<Chunk>& chunks() const { return chunks_; }
+  const Eigen::ArrayXf& patchCentres(int axis) const { return arrays_.patch_centres[axis]; }
+  const Eigen::ArrayXf& patchNormals(int axis) const { return arrays_.patch_normals[axis]; }
+  const Eigen::ArrayXf& patchRadii() const { return arrays_.patch_radii; }
+  const std::vector<Chunk>& chunks() const { return arrays_.chunks; }
 
  private:
   struct KdTree;
@@ -120,17 +120,21 @@ class ReferenceModel {
   void searchRigid(Result& result, const Eigen::Vector3f& query) const;
   template <class Result>
   void searchTurned(Result& result, const Eigen::Vector3f& query) const;
-  std::vector<Eigen::Vector3f> points_;
-  std::vector<Eigen::Vector3f> normals_;
-  std::vector<float> spacing_;
-  std::array<Eigen::ArrayXf, 3> coordinates_;
-  std::array<Eigen::ArrayXf, 3> patch_centres_;
-  std::array<Eigen::ArrayXf, 3> patch_normals_;
-  Eigen::ArrayXf patch_radii_;
-  std::vector<Patch> patches_;
-  std::vector<std::uint8_t> patch_articulated_;  // beside patches_: their loops read begin and end only
-  std::vector<std::uint8_t> point_articulated_;
-  std::vector<Chunk> chunks_;
+  // The model's arrays: what a turn copies, and the memory a turned model gone leaves for the next turn.
+  struct Arrays {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<Eigen::Vector3f> normals;
+    std::vector<float> spacing;
+    std::array<Eigen::ArrayXf, 3> coordinates;
+    std::array<Eigen::ArrayXf, 3> patch_centres;
+    std::array<Eigen::ArrayXf, 3> patch_normals;
+    Eigen::ArrayXf patch_radii;
+    std::vector<Patch> patches;
+    std::vector<std::uint8_t> patch_articulated;  // beside patches: their loops read begin and end only
+    std::vector<std::uint8_t> point_articulated;
+    std::vector<Chunk> chunks;
+  };
+  Arrays arrays_;
   // One tree over every point, or with parts that turn split_, shared by the models turned from one another.
   std::unique_ptr<KdTree> tree_;
   std::shared_ptr<const SplitTrees> split_;
