@@ -160,6 +160,11 @@ struct NeighbourhoodResult {
   bool full() const { return best_index >= 0; }
 };
 
+// A patch's bounding radius: its samples' box, and half a spacing beyond (the surface the samples stand for).
+float patchRadius(const Eigen::AlignedBox3f& samples, float spacing) {
+  return 0.5f * samples.diagonal().norm() + 0.5f * spacing;
+}
+
 // A search of one group of the points (ReferenceModel::SplitTrees): its tree's indices made the model's.
 template <class Result>
 struct GroupResult {
@@ -277,8 +282,7 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
       }
       patch.end = static_cast<std::uint32_t>(arrays_.points.size());
       patch_centres.push_back(box.center());
-      // Half a spacing beyond the outermost samples: the surface the samples stand for.
-      patch_radii.push_back(0.5f * box.diagonal().norm() + 0.5f * spacing[members->front()]);
+      patch_radii.push_back(patchRadius(box, spacing[members->front()]));
       arrays_.patches.push_back(patch);
       chunk_box.extend(box);
     }
@@ -369,8 +373,7 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
       if (!m.arrays_.patch_articulated[p]) continue;
       turned_any = true;
       const Patch& patch = m.arrays_.patches[p];
-      // As the constructor bounds a patch: its samples' box, and half a spacing beyond; its normal is its
-      // first sample's.
+      // Bounded as the constructor bounds a patch; its normal is its first sample's.
       Eigen::AlignedBox3f box;
       for (std::uint32_t i = patch.begin; i < patch.end; ++i) box.extend(m.arrays_.points[i]);
       const Eigen::Vector3f centre = box.center();
@@ -378,7 +381,7 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
         m.arrays_.patch_centres[axis_index][p] = centre[axis_index];
         m.arrays_.patch_normals[axis_index][p] = m.arrays_.normals[patch.begin][axis_index];
       }
-      m.arrays_.patch_radii[p] = 0.5f * box.diagonal().norm() + 0.5f * m.arrays_.spacing[patch.begin];
+      m.arrays_.patch_radii[p] = patchRadius(box, m.arrays_.spacing[patch.begin]);
     }
     if (!turned_any) continue;
     Eigen::AlignedBox3f chunk_box;
