@@ -48,8 +48,10 @@ class TruthPoseNode {
  public:
   TruthPoseNode(ros::NodeHandle& nh, const TruthPoseOptions& options, ardsim_description::TargetKind target)
       : options_(options), generator_(options, VehicleFrames::fromDescription(target)) {
-    // Latched: a subscriber that connects late still gets the estimate of the current lockstep step.
-    pub_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 100, true);
+    // Latched: a subscriber that connects late still gets the estimate of the current lockstep step. A deep
+    // queue per subscriber, as the pose node's: with 100 (1 s of wall at 10x real time) run_monitor, a Python
+    // subscriber that a loaded machine stalls, lost 13-14 of 1694 (dock_short: bag_frames > frames).
+    pub_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 1000, true);
     target_sub_ = nh.subscribe<nav_msgs::Odometry>(
         "truth/target/odom", 100, [this](const nav_msgs::Odometry::ConstPtr& m) { on(m, 0); });
     chaser_sub_ = nh.subscribe<nav_msgs::Odometry>(
