@@ -165,6 +165,12 @@ float patchRadius(const Eigen::AlignedBox3f& samples, float spacing) {
   return 0.5f * samples.diagonal().norm() + 0.5f * spacing;
 }
 
+// A chunk's bounding sphere: its samples' box's centre and half its diagonal.
+void boundChunk(const Eigen::AlignedBox3f& samples, ReferenceModel::Chunk* chunk) {
+  chunk->centre = samples.center();
+  chunk->radius = 0.5f * samples.diagonal().norm();
+}
+
 // A search of one group of the points (ReferenceModel::SplitTrees): its tree's indices made the model's.
 template <class Result>
 struct GroupResult {
@@ -287,8 +293,7 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
       chunk_box.extend(box);
     }
     chunk.end = static_cast<std::uint32_t>(arrays_.patches.size());
-    chunk.centre = chunk_box.center();
-    chunk.radius = 0.5f * chunk_box.diagonal().norm();
+    boundChunk(chunk_box, &chunk);
     arrays_.chunks.push_back(chunk);
   }
   // Arrays for vectorized loops over ranges of patches and points (the points also stay as vectors: the tree
@@ -388,8 +393,7 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
     for (std::uint32_t i = m.arrays_.patches[chunk.begin].begin; i < m.arrays_.patches[chunk.end - 1].end;
          ++i)
       chunk_box.extend(m.arrays_.points[i]);
-    chunk.centre = chunk_box.center();
-    chunk.radius = 0.5f * chunk_box.diagonal().norm();
+    boundChunk(chunk_box, &chunk);
   }
   return turned;
 }
