@@ -890,22 +890,31 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   }
 
   // Valid returns, and the nearest return per visibility cell (for the coverage check).
-  valid_.clear();
-  valid_cells_.clear();
   scan_depth_.assign(static_cast<std::size_t>(visibility().gridWidth()) * visibility().gridHeight(),
                      std::numeric_limits<float>::infinity());
+  // Written through pointers into vectors sized for every pixel, then cut (no capacity check per return:
+  // 0.18 -> 0.10 ms a 256 x 256 frame).
+  valid_.resize(cloud.points.size());
+  valid_cells_.resize(cloud.points.size());
+  std::size_t valid_count = 0;
+  const Eigen::Vector3f* points = cloud.points.data();
+  float* scan_depth = scan_depth_.data();
   for (int v = 0; v < cloud.height; ++v) {
     const int row_cell = visibility().cellOfPixel(0, v);
+    const int row = v * cloud.width;
     for (int u = 0; u < cloud.width; ++u) {
-      const int i = v * cloud.width + u;
-      const Eigen::Vector3f& p = cloud.points[i];
-      if (!p.allFinite() || !(p.z() > 0.0f)) continue;
+      const Eigen::Vector3f& p = points[row + u];
+      if (!(p.z() > 0.0f) || !std::isfinite(p.z()) || !std::isfinite(p.x()) || !std::isfinite(p.y()))
+        continue;
       const int cell = row_cell + column_cells_[u];
-      valid_.push_back(i);
-      valid_cells_.push_back(cell);
-      scan_depth_[cell] = std::min(scan_depth_[cell], p.z());
+      valid_[valid_count] = row + u;
+      valid_cells_[valid_count] = cell;
+      ++valid_count;
+      scan_depth[cell] = std::min(scan_depth[cell], p.z());
     }
   }
+  valid_.resize(valid_count);
+  valid_cells_.resize(valid_count);
   if (valid_.empty()) return lost("empty frame: no valid returns");
   if (static_cast<int>(valid_.size()) < options_.min_points)
     return lost("too few points: " + std::to_string(valid_.size()) + " valid returns < " +
