@@ -66,7 +66,7 @@ bool onWideEdge(const OrganizedCloud& cloud, int u, int v) {
   const auto returns = [&](int x, int y) {
     if (x < 0 || y < 0 || x >= cloud.width || y >= cloud.height) return false;
     const Eigen::Vector3f& p = cloud.points[static_cast<std::size_t>(y) * cloud.width + x];
-    return p.allFinite() && p.z() > 0.0f && std::abs(p.z() - z) < kEdgeDepthJumpM;
+    return isReturn(p) && std::abs(p.z() - z) < kEdgeDepthJumpM;
   };
   const auto edgeAlong = [&](int du, int dv) {
     const bool before = returns(u - du, v - dv), after = returns(u + du, v + dv);
@@ -904,8 +904,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     const int row = v * cloud.width;
     for (int u = 0; u < cloud.width; ++u) {
       const Eigen::Vector3f& p = points[row + u];
-      if (!(p.z() > 0.0f) || !std::isfinite(p.z()) || !std::isfinite(p.x()) || !std::isfinite(p.y()))
-        continue;
+      if (!isReturn(p)) continue;
       const int cell = row_cell + column_cells_[u];
       valid_[valid_count] = row + u;
       valid_cells_[valid_count] = cell;

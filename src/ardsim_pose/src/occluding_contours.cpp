@@ -29,7 +29,7 @@ void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<i
   depth_.assign(static_cast<std::size_t>(w) * h, std::numeric_limits<float>::infinity());
   for (int i = 0; i < w * h; ++i) {
     const Eigen::Vector3f& p = cloud.points[i];
-    if (p.allFinite() && p.z() > 0.0f) depth_[i] = p.z();
+    if (isReturn(p)) depth_[i] = p.z();
   }
   // Saturated returns (retro-reflectors) bloom into the pixels around them at their own range: near one,
   // an edge is not where the surface ends. (Hubble's few reflector pixels left the approach datasets' bands

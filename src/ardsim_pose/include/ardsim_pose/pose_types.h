@@ -1,6 +1,7 @@
 // Types shared by every pose method (ICP, pyramid, docking ring), the mode manager and the nodes. ROS-free.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,12 @@ struct OrganizedCloud {
   std::vector<float> intensity;         // same size as points (may be empty)
   double stamp_s = 0.0;
 };
+
+// Whether a point of such a frame is a return: finite and in front of the sensor. (z first: most pixels of
+// a far target's frame have none, and the test runs on every pixel of every frame.)
+inline bool isReturn(const Eigen::Vector3f& p) {
+  return p.z() > 0.0f && std::isfinite(p.z()) && std::isfinite(p.x()) && std::isfinite(p.y());
+}
 
 enum class EstimateStatus { kTracking, kDegraded, kLost };
 enum class EstimateMethod { kNone, kIcp, kPyramid, kRing };
