@@ -96,6 +96,9 @@ struct ReferenceModel::SplitTrees {
   };
   Group rigid, articulated;
   std::vector<Eigen::Vector3f> articulated_normals;
+  // Triangles of the articulated patches as sampled (index; a triangle listed again where its patches are
+  // not consecutive: turned twice the same way).
+  std::vector<std::pair<std::uint32_t, Triangle>> articulated_triangles;
   // The arrays of the last turned model gone, for the next turn to copy into: allocated anew (~11 MB for
   // Hubble) they cost one turn in three ~30 ms of page faults. One set: a turn needs one while the model
   // before it is still in use.
@@ -243,6 +246,10 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
     }
   }
   if (points.empty()) throw std::invalid_argument("reference model: the mesh has no triangles with area");
+  arrays_.triangles.reserve(mesh.triangles.size());
+  for (const Eigen::Vector3i& corners : mesh.triangles)
+    arrays_.triangles.push_back(
+        {mesh.vertices[corners[0]], mesh.vertices[corners[1]], mesh.vertices[corners[2]]});
 
   // Group the samples into patches (one triangle, a cube of patch_spacings spacings), the patches into
   // chunks, and store the points patch by patch, the patches chunk by chunk.
@@ -279,6 +286,7 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
                                           mesh.triangle_part[triangle] < mesh.parts.size() &&
                                           mesh.parts[mesh.triangle_part[triangle]].articulated);
       patch_normals.push_back(normals[members->front()]);
+      arrays_.patch_triangle.push_back(triangle);
       Eigen::AlignedBox3f box;
       for (std::uint32_t i : *members) {
         arrays_.points.push_back(points[i]);
@@ -323,6 +331,10 @@ ReferenceModel::ReferenceModel(const ardsim_description::TriangleMesh& mesh,
   auto split = std::make_shared<SplitTrees>();
   for (std::size_t p = 0; p < arrays_.patches.size(); ++p) {
     SplitTrees::Group& group = arrays_.patch_articulated[p] ? split->articulated : split->rigid;
+    const std::uint32_t triangle = arrays_.patch_triangle[p];
+    if (arrays_.patch_articulated[p] &&
+        (split->articulated_triangles.empty() || split->articulated_triangles.back().first != triangle))
+      split->articulated_triangles.emplace_back(triangle, arrays_.triangles[triangle]);
     for (std::uint32_t i = arrays_.patches[p].begin; i < arrays_.patches[p].end; ++i) {
       group.points.push_back(arrays_.points[i]);
       group.model_index.push_back(i);
@@ -372,6 +384,8 @@ std::shared_ptr<const ReferenceModel> ReferenceModel::withArticulatedTurned(cons
     for (int axis_index = 0; axis_index < 3; ++axis_index)
       m.arrays_.coordinates[axis_index][i] = m.arrays_.points[i][axis_index];
   }
+  for (const auto& [index, triangle] : m.split_->articulated_triangles)
+    for (int corner = 0; corner < 3; ++corner) m.arrays_.triangles[index][corner] = T * triangle[corner];
   for (Chunk& chunk : m.arrays_.chunks) {
     bool turned_any = false;
     for (std::uint32_t p = chunk.begin; p < chunk.end; ++p) {

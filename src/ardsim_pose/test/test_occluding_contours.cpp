@@ -113,7 +113,12 @@ TEST(OccludingContours, PlaceHubblesRimFarBelowAPixel) {
   ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
   simulator.setTarget(ardsim_description::buildHubble());
   const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
-  for (const double range_m : {45.0, 35.0, 25.0}) {
+  // Every metre from 45 to 25 m: where an edge along a pixel row or column lands relative to the rays
+  // (its sub-pixel phase) is shared by all the pairs along it, so a single range says as much about that
+  // phase as about the placement.
+  double sum_sq = 0.0;
+  int ranges = 0;
+  for (double range_m = 45.0; range_m > 24.5; range_m -= 1.0, ++ranges) {
     SCOPED_TRACE("port at " + std::to_string(range_m) + " m");
     const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kHubble, range_m);
     ardsim_lidar::LidarFrame frame;
@@ -134,9 +139,16 @@ TEST(OccludingContours, PlaceHubblesRimFarBelowAPixel) {
     contours.selectCandidates(*model, predictor.visiblePatches(), start);
     const Eigen::Isometry3d T = alignContours(&contours, start);
     const Eigen::Vector3d port_error = T * T_target_port.translation() - truth * T_target_port.translation();
-    // Across the boresight (lidar x, y): a tenth of a footprint (the start: half of one).
-    EXPECT_LT(port_error.head<2>().norm(), 0.1 * footprint_m) << port_error.transpose();
+    // Across the boresight (lidar x, y), in footprints (the start: half of one). At 35 m straight edges of
+    // the aft end fall exactly on rows of ray centres (a return on one side, none on the other: half a pixel
+    // off by construction, every pair along them): 0.11 there, 0.03 or less at most ranges.
+    const double error_footprints = port_error.head<2>().norm() / footprint_m;
+    EXPECT_LT(error_footprints, 0.12) << port_error.transpose();
+    sum_sq += error_footprints * error_footprints;
   }
+  // 2026-11-24: 0.028 footprints RMS over the 21 ranges (samples as discs of half their spacing, before the
+  // triangles: 0.036).
+  EXPECT_LT(std::sqrt(sum_sq / ranges), 0.033);
 }
 
 }  // namespace

@@ -4,11 +4,12 @@
 // points place its rim only to the sampling (they carry no information within half a pixel's footprint).
 // Here each pair of neighbouring pixels across a depth edge of the scan (a return, and beside it none or one
 // much farther) says the contour crosses between their centres; the model's contour along that line at a
-// pose is the outermost reach of its visible samples (discs of half their spacing) there, near the return's
-// depth. The midpoint is off by at most half a pixel, evenly either way, so hundreds of pairs place the
-// contour far better than a pixel. ROS-free.
+// pose is where the model's triangles there, near the return's depth, stop covering the line through the
+// pixel centres (the rays the sensor samples). The midpoint is off by at most half a pixel, evenly either
+// way, so hundreds of pairs place the contour far better than a pixel. ROS-free.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -31,8 +32,9 @@ class OccludingContours {
   void extract(const OrganizedCloud& cloud, const std::vector<int>& pixels);
   std::size_t pairs() const { return pairs_.size(); }
 
-  // The visible model points (those of patches) that project near a pair's line at T_lidar_target; the
-  // accumulation follows them while the pose moves less than a pixel or two from T_lidar_target.
+  // The triangles of the visible rigid patches (of patches) with samples that project near a pair's line at
+  // T_lidar_target; the accumulation follows them while the pose moves less than a pixel or two from
+  // T_lidar_target.
   void selectCandidates(const ReferenceModel& model, const std::vector<std::uint32_t>& patches,
                         const Eigen::Isometry3d& T_lidar_target);
 
@@ -51,15 +53,27 @@ class OccludingContours {
     int u = 0, v = 0;    // the return's pixel
     int du = 0, dv = 0;  // towards its neighbour across the edge
     float depth_m = 0.0f;
+    int run = 1;  // pairs of this direction side by side along the edge, this one among them
   };
   struct Found {
     bool ok = false;
     double offset_px = 0.0;  // the model's contour minus the pair's midpoint, along (du, dv)
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // its sample: image coordinates (px) and depth (m)
+    // The contour point: image coordinates (px) and depth (m).
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
   };
-  // Projects the candidates at T into their pixels' buckets.
+  // A candidate triangle projected at a pose: its corners (image px, depth m) and image bounds.
+  struct Projected {
+    std::array<Eigen::Vector3f, 3> corners;
+    float u_min, u_max, v_min, v_max;
+  };
+  // Where a triangle covers the pair's line: from along0 to along1 (px from the return's centre towards its
+  // neighbour), with the depth at along1.
+  struct Cover {
+    float along0, along1, depth1;
+  };
+  // Projects the candidates at T and lists them by the pixel columns and rows of the pairs' lines they cross.
   void project(const Eigen::Isometry3d& T_lidar_target);
-  Found find(const Pair& pair) const;
+  Found find(const Pair& pair);
 
   ardsim_lidar::Intrinsics intrinsics_;
   float depth_jump_m_;
@@ -67,22 +81,16 @@ class OccludingContours {
   std::vector<Pair> pairs_;
   std::vector<float> depth_;                  // scratch: per pixel, +inf where no return
   std::vector<std::uint8_t> near_saturated_;  // scratch: per pixel, within the bloom of a saturated return
-  std::vector<std::int32_t> bucket_of_;       // per pixel: its bucket (pixels near a pair's line) or -1
-  int buckets_ = 0;
-  std::vector<std::uint32_t> candidates_;                   // model point indices
-  Eigen::ArrayXf candidate_x_, candidate_y_, candidate_z_;  // their coordinates (target frame)
-  Eigen::ArrayXf candidate_radius_;                         // half their spacing, m
-  Eigen::ArrayXf u_, v_, z_;                                // scratch: their projections
-  float largest_radius_px_ = 0.0f;                          // of the projected, in pixels
-  std::vector<std::uint32_t> bucket_begin_;                 // buckets_ + 1
-  struct Projected {
-    float u, v, z;
-    float radius_px;  // half the sample's spacing
-  };
-  std::vector<Projected> projected_;  // by bucket
-  std::vector<Projected> scratch_;
-  std::vector<std::int32_t> bucket_scratch_;
-  std::vector<std::uint32_t> bucket_next_;  // scratch: the counting sort's next slot per bucket
+  std::vector<std::uint8_t> pair_at_;         // scratch: per pixel and direction, a pair there
+  std::vector<std::uint8_t> near_pair_;       // scratch: per pixel, near a pair's line
+  // Pairs across rows (dv): their columns; across columns (du): their rows.
+  std::vector<std::uint8_t> column_has_pair_, row_has_pair_;
+  std::vector<ReferenceModel::Triangle> candidates_;  // target frame
+  std::vector<std::uint32_t> candidate_mark_;         // per model triangle: the selection that took it
+  std::uint32_t selection_ = 0;
+  std::vector<Projected> projected_;
+  std::vector<std::vector<std::uint32_t>> by_column_, by_row_;  // indices into projected_
+  std::vector<Cover> covers_;                                   // scratch of find
 };
 
 }  // namespace ardsim_pose

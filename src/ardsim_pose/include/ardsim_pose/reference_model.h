@@ -105,6 +105,12 @@ class ReferenceModel {
   bool hasArticulatedParts() const { return split_ != nullptr; }
   // Whether a point is of a part that turns (its patch's flag, per point).
   bool pointArticulated(std::uint32_t point) const { return arrays_.point_articulated[point] != 0; }
+  // The mesh triangle whose samples a patch holds (vertices, target frame; turned with its part): where the
+  // surface really ends, which its samples give only to a spacing.
+  using Triangle = std::array<Eigen::Vector3f, 3>;
+  std::uint32_t patchTriangle(std::uint32_t patch) const { return arrays_.patch_triangle[patch]; }
+  const Triangle& triangle(std::uint32_t index) const { return arrays_.triangles[index]; }
+  std::size_t triangleCount() const { return arrays_.triangles.size(); }
   // The patches' centres, normals (axis 0-2) and radii as arrays (vectorized per chunk).
   const Eigen::ArrayXf& patchCentres(int axis) const { return arrays_.patch_centres[axis]; }
   const Eigen::ArrayXf& patchNormals(int axis) const { return arrays_.patch_normals[axis]; }
@@ -132,6 +138,8 @@ class ReferenceModel {
     std::vector<Patch> patches;
     std::vector<std::uint8_t> patch_articulated;  // beside patches: their loops read begin and end only
     std::vector<std::uint8_t> point_articulated;
+    std::vector<std::uint32_t> patch_triangle;  // index into triangles
+    std::vector<Triangle> triangles;            // the mesh's
     std::vector<Chunk> chunks;
   };
   Arrays arrays_;
