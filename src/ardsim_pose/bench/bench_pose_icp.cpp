@@ -89,7 +89,6 @@ struct Fixture {
     const ardsim_lidar::Intrinsics intrinsics = ardsim_lidar::intrinsicsFor(config.sensor);
     IcpTracker tracker(model, intrinsics, config.icp, config.visibility);
     VisibilityPredictor visibility(intrinsics, config.visibility);
-    std::vector<std::uint8_t> visible;
     ardsim_lidar::LidarFrame rendered;
     for (int range_m : {100, 30, 10}) {
       for (int k = 0; k < kFrames; ++k) {
@@ -109,7 +108,8 @@ struct Fixture {
           pn.getNormalVector3fMap().setZero();
           f.pcl_scan_normals->push_back(pn);
         }
-        visibility.predict(*model, f.guess, &visible);
+        visibility.predict(*model, f.guess);
+        const std::vector<std::uint8_t>& visible = visibility.visible();
         for (std::size_t i = 0; i < model->size(); ++i) {
           if (!visible[i]) continue;
           const Eigen::Vector3f& p = model->points()[i];

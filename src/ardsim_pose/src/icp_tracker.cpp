@@ -424,7 +424,7 @@ void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_
   ++visibility_generation_;
   VisibilitySlot& slot = slots_[current_];
   if (serves(slot)) return;
-  slot.visible_points = slot.predictor.predict(*model_, T, depth_only ? nullptr : &slot.visible);
+  slot.visible_points = slot.predictor.predict(*model_, T, !depth_only);
   slot.pose = T;
   slot.valid = true;
   slot.depth_only = depth_only;
@@ -435,20 +435,22 @@ void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_
 void IcpTracker::markSilhouette(int r) {
   const std::vector<float>& model_depth = visibility().modelDepth();
   const int w = visibility().gridWidth(), h = visibility().gridHeight();
-  // Square dilation of the silhouette's cells by r, separably (rows, then columns).
-  silhouette_rows_.assign(model_depth.size(), 0);
-  silhouette_.assign(model_depth.size(), 0);
+  // Square dilation of the silhouette's cells by r, separably (rows, then columns), each cell from prefix
+  // counts along its row or column: the same cells as writing each one's square, in time independent of r.
+  silhouette_rows_.resize(model_depth.size());
+  silhouette_.resize(model_depth.size());
+  std::vector<int>& prefix = silhouette_prefix_;
+  prefix.resize(static_cast<std::size_t>(std::max(w, h)) + 1);
+  prefix[0] = 0;
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (!std::isfinite(model_depth[y * w + x])) continue;
-      for (int k = std::max(0, x - r); k <= std::min(w - 1, x + r); ++k) silhouette_rows_[y * w + k] = 1;
-    }
+    for (int x = 0; x < w; ++x) prefix[x + 1] = prefix[x] + (std::isfinite(model_depth[y * w + x]) ? 1 : 0);
+    for (int x = 0; x < w; ++x)
+      silhouette_rows_[y * w + x] = prefix[std::min(w, x + r + 1)] > prefix[std::max(0, x - r)] ? 1 : 0;
   }
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (!silhouette_rows_[y * w + x]) continue;
-      for (int k = std::max(0, y - r); k <= std::min(h - 1, y + r); ++k) silhouette_[k * w + x] = 1;
-    }
+  for (int x = 0; x < w; ++x) {
+    for (int y = 0; y < h; ++y) prefix[y + 1] = prefix[y] + silhouette_rows_[y * w + x];
+    for (int y = 0; y < h; ++y)
+      silhouette_[y * w + x] = prefix[std::min(h, y + r + 1)] > prefix[std::max(0, y - r)] ? 1 : 0;
   }
 }
 
@@ -476,9 +478,14 @@ void IcpTracker::gateToSilhouette(const Eigen::Isometry3d& T, double margin_px, 
   const int r = static_cast<int>(std::ceil(margin_px / visibility().cellPx()));
   if (r >= std::max(visibility().gridWidth(), visibility().gridHeight())) return;
   markSilhouette(r);
-  gated_.clear();
-  for (std::size_t k = 0; k < valid_.size(); ++k)
-    if (silhouette_[valid_cells_[k]]) gated_.push_back(valid_[k]);
+  // Written by index, the count advanced by the flag (no branch, no capacity check per pixel).
+  gated_.resize(valid_.size());
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < valid_.size(); ++k) {
+    gated_[count] = valid_[k];
+    count += silhouette_[valid_cells_[k]];
+  }
+  gated_.resize(count);
   if (static_cast<int>(gated_.size()) < options_.min_points) gated_ = valid_;
 }
 

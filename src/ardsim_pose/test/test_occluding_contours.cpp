@@ -132,8 +132,7 @@ TEST(OccludingContours, PlaceHubblesRimFarBelowAPixel) {
     Eigen::Isometry3d start = truth;
     start.translation() += 0.5 * footprint_m * Eigen::Vector3d(0.8, -0.6, 0.0);
     VisibilityPredictor predictor(intrinsics, config.visibility);
-    std::vector<std::uint8_t> visible;
-    predictor.predict(*model, start, &visible);
+    predictor.predict(*model, start);
     OccludingContours contours(intrinsics);
     contours.extract(cloud, pixels);
     contours.selectCandidates(*model, predictor.visiblePatches(), start);

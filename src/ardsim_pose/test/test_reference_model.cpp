@@ -36,8 +36,8 @@ TEST_P(VisiblePointGridCase, AnswersAsTheTreeDoes) {
   T.prerotate(Eigen::AngleAxisd(c.turn_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()));
   T.pretranslate(Eigen::Vector3d(c.lateral_m, 0.0, 0.0));
   VisibilityPredictor predictor(intrinsics, config.visibility);
-  std::vector<std::uint8_t> visible;
-  ASSERT_GT(predictor.predict(*model, T, &visible), 1000);
+  ASSERT_GT(predictor.predict(*model, T), 1000);
+  const std::vector<std::uint8_t>& visible = predictor.visible();
   VisiblePointGrid grid(intrinsics, config.visibility.margin_px);
   grid.build(*model, predictor.visiblePatches(), T, predictor.nearestDepth());
 

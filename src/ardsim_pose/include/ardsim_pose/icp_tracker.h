@@ -148,7 +148,7 @@ class IcpTracker : public PoseMethod {
   // Of the last frame: fraction of the cells where the model is predicted that the scan confirms.
   double lastCoverage() const { return coverage_; }
   // Of the last frame: the visibility mask and the scan subsample (lidar frame), for benchmarks and tests.
-  const std::vector<std::uint8_t>& lastVisible() const { return slots_[current_].visible; }
+  const std::vector<std::uint8_t>& lastVisible() const { return slots_[current_].predictor.visible(); }
   const std::vector<Eigen::Vector3f>& lastScanPoints() const { return scan_; }
   const ReferenceModel& model() const { return *model_; }
   const IcpOptions& options() const { return options_; }
@@ -193,7 +193,7 @@ class IcpTracker : public PoseMethod {
   // coverage and silhouette checks), not the visible points; such a one serves no other request.
   void predictVisibility(const Eigen::Isometry3d& T, double tolerance_px = 0.0, bool depth_only = false);
   const VisibilityPredictor& visibility() const { return slots_[current_].predictor; }
-  const std::vector<std::uint8_t>& visible() const { return slots_[current_].visible; }
+  const std::vector<std::uint8_t>& visible() const { return slots_[current_].predictor.visible(); }
   // The norm (m; rotations times the correspondences' lever arm) of the move from T_from to T_to in the weak
   // directions of the lever-scaled normal equations about centre (eigen: of their first five unknowns).
   double weakPart(const Eigen::Isometry3d& T_from, const Eigen::Isometry3d& T_to,
@@ -254,7 +254,6 @@ class IcpTracker : public PoseMethod {
     VisibilitySlot(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options)
         : predictor(intrinsics, options), grid(intrinsics, options.margin_px) {}
     VisibilityPredictor predictor;
-    std::vector<std::uint8_t> visible;
     int visible_points = 0;
     VisiblePointGrid grid;  // of the visible points, built when enough searches are due (IcpTracker::grid)
     bool grid_built = false;
@@ -300,6 +299,7 @@ class IcpTracker : public PoseMethod {
   std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
   std::vector<std::uint8_t> silhouette_;       // see markSilhouette
+  std::vector<int> silhouette_prefix_;         // scratch: counts along a row or column
   std::vector<float> scan_depth_;
   struct Correspondence {
     Eigen::Vector3d scan;    // lidar frame

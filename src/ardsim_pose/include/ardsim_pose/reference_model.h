@@ -164,11 +164,12 @@ class VisibilityPredictor {
  public:
   VisibilityPredictor(const ardsim_lidar::Intrinsics& intrinsics, const VisibilityOptions& options);
 
-  // Fills visible (one flag per model point) and the per-cell depth of the nearest predicted surface.
-  // Returns the number of visible points. visible nullptr: the depths alone (no visibility test per patch),
-  // returns 0.
-  int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target,
-              std::vector<std::uint8_t>* visible);
+  // The per-cell depth of the nearest predicted surface and, with_points, which model points are visible
+  // (visible()). Returns the number of visible points; without points the depths alone (no visibility test
+  // per patch), 0.
+  int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target, bool with_points = true);
+  // One flag per point of the model of the last predict(); all 0 after one without points.
+  const std::vector<std::uint8_t>& visible() const { return visible_; }
 
   int gridWidth() const { return grid_width_; }
   int gridHeight() const { return grid_height_; }
@@ -200,7 +201,9 @@ class VisibilityPredictor {
   };
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> visible_patches_;
-  Eigen::ArrayXf facing_, depth_z_, inv_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
+  std::vector<std::uint8_t> visible_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> visible_ranges_;  // [begin, end) of visible_ set to 1
+  Eigen::ArrayXf facing_, depth_z_, inv_z_, u_, v_, radius_px_;          // scratch: per patch of a chunk
 };
 
 // The visible model points binned by the pixels they project to at one pose: an exact nearest-visible-point
