@@ -39,7 +39,7 @@ TEST_P(VisiblePointGridCase, AnswersAsTheTreeDoes) {
   ASSERT_GT(predictor.predict(*model, T), 1000);
   const std::vector<std::uint8_t>& visible = predictor.visible();
   VisiblePointGrid grid(intrinsics, config.visibility.margin_px);
-  grid.build(*model, predictor.visiblePatches(), T, predictor.nearestDepth());
+  grid.build(*model, predictor.visibleRanges(), T, predictor.nearestDepth());
 
   std::vector<std::uint32_t> visible_points;
   for (std::uint32_t i = 0; i < model->size(); ++i)

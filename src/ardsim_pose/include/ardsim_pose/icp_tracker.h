@@ -293,8 +293,9 @@ class IcpTracker : public PoseMethod {
   // The nearest visible model point to q (target frame) within the gate for scan_ point k, from its ball
   // when that answers exactly, else from the tree (and a new ball).
   int nearestVisible(int k, const Eigen::Vector3f& q, float gate_sq, float* distance_sq);
-  std::vector<int> valid_;
-  std::vector<int> valid_cells_;               // their visibility cells
+  std::vector<int> valid_;        // the frame's valid pixels: the first valid_count_
+  std::vector<int> valid_cells_;  // their visibility cells
+  std::size_t valid_count_ = 0;
   std::vector<int> column_cells_;              // the cell column of each pixel column
   std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
   std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows

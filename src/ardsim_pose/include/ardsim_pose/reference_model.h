@@ -150,6 +150,9 @@ class ReferenceModel {
   Eigen::Isometry3f T_sampled_model_ = Eigen::Isometry3f::Identity();  // its inverse, for the queries
 };
 
+// Model points [first, second).
+using PointRange = std::pair<std::uint32_t, std::uint32_t>;
+
 struct VisibilityOptions {
   int cell_px = 4;          // the depth buffer's cells are cell_px x cell_px sensor pixels
   double margin_px = 12.0;  // points this far outside the image still count (the prediction is not exact)
@@ -180,8 +183,10 @@ class VisibilityPredictor {
   float nearestDepth() const { return nearest_depth_; }
   // Cell of a pixel (inside the image).
   int cellOfPixel(int u, int v) const { return (v / options_.cell_px) * grid_width_ + u / options_.cell_px; }
-  // The patches judged visible by the last predict() (their points are the visible ones).
+  // The patches judged visible by the last predict() (their points are the visible ones), in order.
   const std::vector<std::uint32_t>& visiblePatches() const { return visible_patches_; }
+  // Their points as ranges of model indices, consecutive patches joined.
+  const std::vector<PointRange>& visibleRanges() const { return visible_ranges_; }
 
  private:
   ardsim_lidar::Intrinsics intrinsics_;
@@ -202,8 +207,8 @@ class VisibilityPredictor {
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> visible_patches_;
   std::vector<std::uint8_t> visible_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> visible_ranges_;  // [begin, end) of visible_ set to 1
-  Eigen::ArrayXf facing_, depth_z_, inv_z_, u_, v_, radius_px_;          // scratch: per patch of a chunk
+  std::vector<PointRange> visible_ranges_;                       // the flags set to 1
+  Eigen::ArrayXf facing_, depth_z_, inv_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
 };
 
 // The visible model points binned by the pixels they project to at one pose: an exact nearest-visible-point
@@ -216,9 +221,9 @@ class VisiblePointGrid {
  public:
   VisiblePointGrid(const ardsim_lidar::Intrinsics& intrinsics, double margin_px);
 
-  // Bins the points of the patches (target frame) as seen from T_lidar_target.
+  // Bins the model points in the ranges (target frame) as seen from T_lidar_target.
   // depth_m: the depth of the nearest predicted surface (the bins' size follows it).
-  void build(const ReferenceModel& model, const std::vector<std::uint32_t>& patches,
+  void build(const ReferenceModel& model, const std::vector<PointRange>& ranges,
              const Eigen::Isometry3d& T_lidar_target, double depth_m);
   // The nearest binned point within sqrt(max_distance_sq) of query (target frame; index -1: none) when the
   // grid can tell exactly (returns true; false: ask the tree). With near: as
@@ -240,8 +245,7 @@ class VisiblePointGrid {
   std::vector<Eigen::Vector3f> bin_points_;  // target frame, bin by bin
   std::vector<std::uint32_t> bin_index_;     // their model point indices
   std::vector<std::int32_t> bin_of_;         // scratch: bin per point of the patches
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> runs_;   // scratch: the patches' point ranges
-  Eigen::ArrayXf x_, y_, z_;                                    // scratch
+  Eigen::ArrayXf x_, y_, z_;                 // scratch
   mutable std::vector<std::pair<float, std::uint32_t>> found_;  // scratch of nearest()
 };
 
