@@ -91,10 +91,23 @@ class ReferenceModel {
     std::uint32_t begin = 0;
     std::uint32_t end = 0;
   };
-  // Patches close together: one frustum test for all (patches [begin, end)).
+  // Patches close together: one frustum test for all (patches [begin, end), plane runs [run_begin, run_end)).
   struct Chunk {
     Eigen::Vector3f centre;
     float radius = 0.0f;
+    std::uint32_t begin = 0;
+    std::uint32_t end = 0;
+    std::uint32_t run_begin = 0;
+    std::uint32_t run_end = 0;
+  };
+  // A chunk's patches of one triangle (patches [begin, end)): one back-face test for all where the sensor is
+  // clearly on one side of the plane (normal . centre of each patch between offset_min and offset_max;
+  // extent: the largest |centre|_1, for how far a patch's own test may round).
+  struct PlaneRun {
+    Eigen::Vector3f normal;
+    float offset_min = 0.0f;
+    float offset_max = 0.0f;
+    float extent = 0.0f;
     std::uint32_t begin = 0;
     std::uint32_t end = 0;
   };
@@ -116,6 +129,7 @@ class ReferenceModel {
   const Eigen::ArrayXf& patchNormals(int axis) const { return arrays_.patch_normals[axis]; }
   const Eigen::ArrayXf& patchRadii() const { return arrays_.patch_radii; }
   const std::vector<Chunk>& chunks() const { return arrays_.chunks; }
+  const std::vector<PlaneRun>& planeRuns() const { return arrays_.plane_runs; }
 
  private:
   struct KdTree;
@@ -141,7 +155,10 @@ class ReferenceModel {
     std::vector<std::uint32_t> patch_triangle;  // index into triangles
     std::vector<Triangle> triangles;            // the mesh's
     std::vector<Chunk> chunks;
+    std::vector<PlaneRun> plane_runs;
   };
+  // The plane run's bounds from its patches' centres and normal.
+  void boundPlaneRun(PlaneRun* run) const;
   Arrays arrays_;
   // One tree over every point, or with parts that turn split_, shared by the models turned from one another.
   std::unique_ptr<KdTree> tree_;
@@ -208,7 +225,7 @@ class VisibilityPredictor {
   std::vector<std::uint32_t> visible_patches_;
   std::vector<std::uint8_t> visible_;
   std::vector<PointRange> visible_ranges_;                       // the flags set to 1
-  Eigen::ArrayXf facing_, depth_z_, inv_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
+  Eigen::ArrayXf depth_z_, inv_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
 };
 
 // The visible model points binned by the pixels they project to at one pose: an exact nearest-visible-point
