@@ -435,22 +435,24 @@ void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_
 void IcpTracker::markSilhouette(int r) {
   const std::vector<float>& model_depth = visibility().modelDepth();
   const int w = visibility().gridWidth(), h = visibility().gridHeight();
-  // Square dilation of the silhouette's cells by r, separably (rows, then columns), each cell from prefix
-  // counts along its row or column: the same cells as writing each one's square, in time independent of r.
-  silhouette_rows_.resize(model_depth.size());
-  silhouette_.resize(model_depth.size());
-  std::vector<int>& prefix = silhouette_prefix_;
-  prefix.resize(static_cast<std::size_t>(std::max(w, h)) + 1);
-  prefix[0] = 0;
+  // Square dilation of the silhouette's cells by r, separably: each cell ORs the cells up to r either side
+  // along its row, then along its column, a shift at a time (byte loops the compiler vectorizes).
+  silhouette_cells_.resize(model_depth.size());
+  for (std::size_t i = 0; i < model_depth.size(); ++i) silhouette_cells_[i] = std::isfinite(model_depth[i]);
+  silhouette_rows_.assign(model_depth.size(), 0);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) prefix[x + 1] = prefix[x] + (std::isfinite(model_depth[y * w + x]) ? 1 : 0);
-    for (int x = 0; x < w; ++x)
-      silhouette_rows_[y * w + x] = prefix[std::min(w, x + r + 1)] > prefix[std::max(0, x - r)] ? 1 : 0;
+    const std::uint8_t* in = silhouette_cells_.data() + y * w;
+    std::uint8_t* out = silhouette_rows_.data() + y * w;
+    for (int d = -std::min(r, w - 1); d <= std::min(r, w - 1); ++d)
+      for (int x = std::max(0, -d); x < std::min(w, w - d); ++x) out[x] |= in[x + d];
   }
-  for (int x = 0; x < w; ++x) {
-    for (int y = 0; y < h; ++y) prefix[y + 1] = prefix[y] + silhouette_rows_[y * w + x];
-    for (int y = 0; y < h; ++y)
-      silhouette_[y * w + x] = prefix[std::min(h, y + r + 1)] > prefix[std::max(0, y - r)] ? 1 : 0;
+  silhouette_.assign(model_depth.size(), 0);
+  for (int y = 0; y < h; ++y) {
+    std::uint8_t* out = silhouette_.data() + y * w;
+    for (int row = std::max(0, y - r); row <= std::min(h - 1, y + r); ++row) {
+      const std::uint8_t* in = silhouette_rows_.data() + row * w;
+      for (int x = 0; x < w; ++x) out[x] |= in[x];
+    }
   }
 }
 

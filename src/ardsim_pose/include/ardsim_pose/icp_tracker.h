@@ -296,11 +296,11 @@ class IcpTracker : public PoseMethod {
   std::vector<int> valid_;        // the frame's valid pixels: the first valid_count_
   std::vector<int> valid_cells_;  // their visibility cells
   std::size_t valid_count_ = 0;
-  std::vector<int> column_cells_;              // the cell column of each pixel column
-  std::vector<int> gated_;                     // the valid_ pixels near the predicted silhouette
-  std::vector<std::uint8_t> silhouette_rows_;  // scratch: cells dilated along rows
-  std::vector<std::uint8_t> silhouette_;       // see markSilhouette
-  std::vector<int> silhouette_prefix_;         // scratch: counts along a row or column
+  std::vector<int> column_cells_;               // the cell column of each pixel column
+  std::vector<int> gated_;                      // the valid_ pixels near the predicted silhouette
+  std::vector<std::uint8_t> silhouette_cells_;  // scratch: cells with a predicted surface
+  std::vector<std::uint8_t> silhouette_rows_;   // scratch: those dilated along rows
+  std::vector<std::uint8_t> silhouette_;        // see markSilhouette
   std::vector<float> scan_depth_;
   struct Correspondence {
     Eigen::Vector3d scan;    // lidar frame
