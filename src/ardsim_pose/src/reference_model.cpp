@@ -723,7 +723,8 @@ void VisiblePointGrid::build(const ReferenceModel& model, const std::vector<Poin
   std::uint32_t* counts = bin_begin_.data() + 1;
   for (std::size_t k = 0; k < n; ++k) ++counts[bin_of_[k]];
   for (std::size_t b = 1; b < bin_begin_.size(); ++b) bin_begin_[b] += bin_begin_[b - 1];
-  bin_points_.resize(n);
+  // Three more than the points: a search reads four at a time.
+  for (std::vector<float>* c : {&bin_x_, &bin_y_, &bin_z_}) c->resize(n + 3);
   bin_index_.resize(n);
   // bin_begin_[b] runs through bin b while filling, and ends where bin b + 1 began.
   std::uint32_t* next = bin_begin_.data();
@@ -732,7 +733,9 @@ void VisiblePointGrid::build(const ReferenceModel& model, const std::vector<Poin
   for (const auto& [begin, end] : ranges) {
     for (std::uint32_t i = begin; i < end; ++i, ++n) {
       const std::uint32_t slot = next[bin_of_[n]]++;
-      bin_points_[slot] = points[i];
+      bin_x_[slot] = points[i].x();
+      bin_y_[slot] = points[i].y();
+      bin_z_[slot] = points[i].z();
       bin_index_[slot] = i;
     }
   }
@@ -764,15 +767,25 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
   const auto scan = [&](int ua, int ub, int va, int vb) {
     for (int y = va; y <= vb; ++y) {
       const std::size_t row = static_cast<std::size_t>(y + 1) * (bins_wide_ + 2) + 1;  // past the border
-      for (std::uint32_t k = bin_begin_[row + ua]; k < bin_begin_[row + ub + 1]; ++k) {
-        const float d = treeDistanceSq(query, bin_points_[k]);
-        if (!(d < ball_limit_sq)) continue;
-        if (near != nullptr) found_.push_back({d, bin_index_[k]});
-        if (d < best_sq) {
-          best_sq = d;
-          best = static_cast<int>(bin_index_[k]);
-          const float limit = std::sqrt(d) + margin_m;
-          ball_limit_sq = std::min(max_distance_sq, limit * limit);
+      const std::uint32_t end = bin_begin_[row + ub + 1];
+      for (std::uint32_t k = bin_begin_[row + ua]; k < end; k += 4) {
+        // Four points' distances at once, summed as treeDistanceSq sums them; one not within the limit as it
+        // was before the four is not within it after any of them (it only shrinks). Past end: not read.
+        const Eigen::Array4f dx = Eigen::Map<const Eigen::Array4f>(bin_x_.data() + k) - query.x();
+        const Eigen::Array4f dy = Eigen::Map<const Eigen::Array4f>(bin_y_.data() + k) - query.y();
+        const Eigen::Array4f dz = Eigen::Map<const Eigen::Array4f>(bin_z_.data() + k) - query.z();
+        const Eigen::Array4f d4 = dx * dx + dy * dy + dz * dz;
+        if (!(d4 < ball_limit_sq).any()) continue;
+        for (std::uint32_t lane = 0; lane < 4 && k + lane < end; ++lane) {
+          const float d = d4[lane];
+          if (!(d < ball_limit_sq)) continue;
+          if (near != nullptr) found_.push_back({d, bin_index_[k + lane]});
+          if (d < best_sq) {
+            best_sq = d;
+            best = static_cast<int>(bin_index_[k + lane]);
+            const float limit = std::sqrt(d) + margin_m;
+            ball_limit_sq = std::min(max_distance_sq, limit * limit);
+          }
         }
       }
     }

@@ -224,7 +224,7 @@ class VisibilityPredictor {
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> visible_patches_;
   std::vector<std::uint8_t> visible_;
-  std::vector<PointRange> visible_ranges_;                       // the flags set to 1
+  std::vector<PointRange> visible_ranges_;              // the flags set to 1
   Eigen::ArrayXf depth_z_, inv_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
 };
 
@@ -258,11 +258,11 @@ class VisiblePointGrid {
   float min_cos_sq_ = 1.0f;  // squared cosine of the off-axis angle of the padded image's corner
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   Eigen::Vector3f t_ = Eigen::Vector3f::Zero();
-  std::vector<std::uint32_t> bin_begin_;     // (bins_wide_ + 2) x (bins_high_ + 2) + 1: a border of one bin
-  std::vector<Eigen::Vector3f> bin_points_;  // target frame, bin by bin
-  std::vector<std::uint32_t> bin_index_;     // their model point indices
-  std::vector<std::int32_t> bin_of_;         // scratch: bin per point of the patches
-  Eigen::ArrayXf x_, y_, z_;                 // scratch
+  std::vector<std::uint32_t> bin_begin_;      // (bins_wide_ + 2) x (bins_high_ + 2) + 1: a border of one bin
+  std::vector<float> bin_x_, bin_y_, bin_z_;  // target frame, bin by bin (by axis: read four at a time)
+  std::vector<std::uint32_t> bin_index_;      // their model point indices
+  std::vector<std::int32_t> bin_of_;          // scratch: bin per point of the patches
+  Eigen::ArrayXf x_, y_, z_;                  // scratch
   mutable std::vector<std::pair<float, std::uint32_t>> found_;  // scratch of nearest()
 };
 
