@@ -902,9 +902,8 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   // Valid returns, and the nearest return per visibility cell (for the coverage check).
   scan_depth_.assign(static_cast<std::size_t>(visibility().gridWidth()) * visibility().gridHeight(),
                      std::numeric_limits<float>::infinity());
-  // Written by index into vectors sized for every pixel, then cut (no capacity check per return: 0.18 ->
-  // 0.10 ms a 256 x 256 frame).
-  // Not cut to the count after (the next frame's resize would zero what it cut, 0.2 M instructions).
+  // Written by index into vectors sized for every pixel (no capacity check per return: 0.18 -> 0.10 ms a
+  // 256 x 256 frame), and not cut to the count after (the next frame's resize would zero what it cut).
   valid_.resize(cloud.points.size());
   valid_cells_.resize(cloud.points.size());
   std::size_t valid_count = 0;
