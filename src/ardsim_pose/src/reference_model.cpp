@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include <nanoflann.hpp>
@@ -574,53 +575,71 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
     us = fx * (R(0, 0) * CX + R(0, 1) * CY + R(0, 2) * CZ + t.x()) * inv_z + cx;
     vs = fy * (R(1, 0) * CX + R(1, 1) * CY + R(1, 2) * CZ + t.y()) * inv_z + cy;
     radii_px = radii * fx * inv_z;
+    // Every patch (back faces and those behind the sensor included) two cells inside the padded image: none
+    // needs the bounds test or the clamps below (a floor and a rounding cost less than a cell each).
+    const float inner = 2.0f * cell;
+    const bool inside =
+        (us - radii_px).minCoeff() >= u_min + inner && (us + radii_px).maxCoeff() <= u_max - inner &&
+        (vs - radii_px).minCoeff() >= v_min + inner && (vs + radii_px).maxCoeff() <= v_max - inner;
     const float* NX = model.patchNormals(0).data() + begin;
     const float* NY = model.patchNormals(1).data() + begin;
     const float* NZ = model.patchNormals(2).data() + begin;
-    for (std::uint32_t r = chunk.run_begin; r < chunk.run_end; ++r) {
-      // Back faces (seen from behind: half the patches) by their triangle's plane where the sensor is clearly
-      // on one side of it (by more than a patch's own test may round; every ISS run from 9 to 99 m on the
-      // docking axis), else patch by patch. (Also skipping the back runs' arithmetic above: no faster.)
-      const ReferenceModel::PlaneRun& run = model.planeRuns()[r];
-      const float eye_offset = run.normal.dot(eye);
-      const float slack = kPlaneRunSlack * (run.extent + eye_l1);
-      if (run.offset_min - eye_offset > slack) continue;
-      const bool front = eye_offset - run.offset_max > slack;
-      for (Eigen::Index k = run.begin - begin; k < run.end - begin; ++k) {
-        if (!front &&
-            NX[k] * (CX[k] - eye.x()) + NY[k] * (CY[k] - eye.y()) + NZ[k] * (CZ[k] - eye.z()) >= 0.0f)
-          continue;
-        if (z[k] < 0.05f) continue;
-        const std::uint32_t i = static_cast<std::uint32_t>(begin + k);
-        const float u = us[k], v = vs[k];
-        const float depth = z[k], radius_px = radii_px[k];
-        if (u + radius_px < u_min || u - radius_px >= u_max || v + radius_px < v_min ||
-            v - radius_px >= v_max)
-          continue;
-        const int cu = floorToInt((u + 0.5f) * inv_cell + offset);
-        const int cv = floorToInt((v + 0.5f) * inv_cell + offset);
-        // Splat the patch over the cells it covers, so that it hides what is behind it.
-        const int radius = std::min(16, static_cast<int>(radius_px * inv_cell + 0.5f));
-        const int x0 = std::max(0, cu - radius), x1 = std::min(padded_width_ - 1, cu + radius);
-        const int y0 = std::max(0, cv - radius), y1 = std::min(padded_height_ - 1, cv + radius);
-        float* row = depth_.data() + static_cast<std::size_t>(y0) * padded_width_;
-        if (x1 - x0 == 2 && y1 - y0 == 2) {  // most patches from 30 m in: 3 x 3 cells, unrolled
-          for (int y = 0; y < 3; ++y, row += padded_width_) {
+    // Compiled twice: with and without the bounds test and clamps.
+    const auto splat = [&](auto inside_constant) {
+      constexpr bool kInside = decltype(inside_constant)::value;
+      for (std::uint32_t r = chunk.run_begin; r < chunk.run_end; ++r) {
+        // Back faces (seen from behind: half the patches) by their triangle's plane where the sensor is
+        // clearly on one side of it (by more than a patch's own test may round; every ISS run from 9 to 99 m
+        // on the docking axis), else patch by patch. (Also skipping the back runs' arithmetic above: no
+        // faster.)
+        const ReferenceModel::PlaneRun& run = model.planeRuns()[r];
+        const float eye_offset = run.normal.dot(eye);
+        const float slack = kPlaneRunSlack * (run.extent + eye_l1);
+        if (run.offset_min - eye_offset > slack) continue;
+        const bool front = eye_offset - run.offset_max > slack;
+        for (Eigen::Index k = run.begin - begin; k < run.end - begin; ++k) {
+          if (!front &&
+              NX[k] * (CX[k] - eye.x()) + NY[k] * (CY[k] - eye.y()) + NZ[k] * (CZ[k] - eye.z()) >= 0.0f)
+            continue;
+          if (z[k] < 0.05f) continue;
+          const std::uint32_t i = static_cast<std::uint32_t>(begin + k);
+          const float u = us[k], v = vs[k];
+          const float depth = z[k], radius_px = radii_px[k];
+          if (!kInside && (u + radius_px < u_min || u - radius_px >= u_max || v + radius_px < v_min ||
+                           v - radius_px >= v_max))
+            continue;
+          const int cu = floorToInt((u + 0.5f) * inv_cell + offset);
+          const int cv = floorToInt((v + 0.5f) * inv_cell + offset);
+          // Splat the patch over the cells it covers, so that it hides what is behind it.
+          const int radius = std::min(16, static_cast<int>(radius_px * inv_cell + 0.5f));
+          const int x0 = kInside ? cu - radius : std::max(0, cu - radius);
+          const int x1 = kInside ? cu + radius : std::min(padded_width_ - 1, cu + radius);
+          const int y0 = kInside ? cv - radius : std::max(0, cv - radius);
+          const int y1 = kInside ? cv + radius : std::min(padded_height_ - 1, cv + radius);
+          float* row = depth_.data() + static_cast<std::size_t>(y0) * padded_width_;
+          if (x1 - x0 == 2 && y1 - y0 == 2) {  // most patches from 30 m in: 3 x 3 cells, unrolled
+            for (int y = 0; y < 3; ++y, row += padded_width_) {
+              row[x0] = std::min(row[x0], depth);
+              row[x0 + 1] = std::min(row[x0 + 1], depth);
+              row[x0 + 2] = std::min(row[x0 + 2], depth);
+            }
+          } else if (x0 == x1 && y0 == y1) {  // one cell: a patch under 2 px across
             row[x0] = std::min(row[x0], depth);
-            row[x0 + 1] = std::min(row[x0 + 1], depth);
-            row[x0 + 2] = std::min(row[x0 + 2], depth);
+          } else {
+            for (int y = y0; y <= y1; ++y, row += padded_width_)
+              for (int x = x0; x <= x1; ++x) row[x] = std::min(row[x], depth);
           }
-        } else if (x0 == x1 && y0 == y1) {  // one cell: a patch under 2 px across
-          row[x0] = std::min(row[x0], depth);
-        } else {
-          for (int y = y0; y <= y1; ++y, row += padded_width_)
-            for (int x = x0; x <= x1; ++x) row[x] = std::min(row[x], depth);
+          const int cell_index = kInside ? cv * padded_width_ + cu
+                                         : std::clamp(cv, 0, padded_height_ - 1) * padded_width_ +
+                                               std::clamp(cu, 0, padded_width_ - 1);
+          if (with_points) candidates_.push_back({i, cell_index, depth - radii[k]});
         }
-        const int cell_index =
-            std::clamp(cv, 0, padded_height_ - 1) * padded_width_ + std::clamp(cu, 0, padded_width_ - 1);
-        if (with_points) candidates_.push_back({i, cell_index, depth - radii[k]});
       }
-    }
+    };
+    if (inside)
+      splat(std::true_type{});
+    else
+      splat(std::false_type{});
   }
   int count = 0;
   for (const Candidate& candidate : candidates_) {
