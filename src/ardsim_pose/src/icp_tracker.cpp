@@ -474,11 +474,11 @@ double IcpTracker::silhouetteInlierFraction(double limit_m) {
 }
 
 void IcpTracker::gateToSilhouette(const Eigen::Isometry3d& T, double margin_px, double tolerance_px) {
-  gated_.assign(valid_.begin(), valid_.begin() + valid_count_);
-  if (!(margin_px > 0.0)) return;
+  const auto keepAll = [&] { gated_.assign(valid_.begin(), valid_.begin() + valid_count_); };
+  if (!(margin_px > 0.0)) return keepAll();
   predictVisibility(T, tolerance_px);
   const int r = static_cast<int>(std::ceil(margin_px / visibility().cellPx()));
-  if (r >= std::max(visibility().gridWidth(), visibility().gridHeight())) return;
+  if (r >= std::max(visibility().gridWidth(), visibility().gridHeight())) return keepAll();
   markSilhouette(r);
   // Written by index, the count advanced by the flag (no branch, no capacity check per pixel).
   gated_.resize(valid_count_);
@@ -488,8 +488,7 @@ void IcpTracker::gateToSilhouette(const Eigen::Isometry3d& T, double margin_px, 
     count += silhouette_[valid_cells_[k]];
   }
   gated_.resize(count);
-  if (static_cast<int>(gated_.size()) < options_.min_points)
-    gated_.assign(valid_.begin(), valid_.begin() + valid_count_);
+  if (static_cast<int>(gated_.size()) < options_.min_points) keepAll();
 }
 
 const VisiblePointGrid* IcpTracker::grid() {
