@@ -24,8 +24,8 @@ namespace {
 // exact value times |centre|_1 + |eye|_1: a plane run decides for all its patches beyond 1e-5 of that.
 constexpr float kPlaneRunSlack = 1e-5f;
 
-// floor(x) as an int, for x within int's range: std::floor is a call on baseline x86-64 (no SSE4.1 rounding),
-// ~13 % of a prediction's instructions as two per patch.
+// floor(x) as an int, for x within int's range: without SSE4.1's rounding instruction (baseline x86-64)
+// std::floor expands to a longer sequence, ~12 % of a prediction's instructions as two per patch.
 int floorToInt(float x) {
   const int truncated = static_cast<int>(x);
   return truncated - (x < static_cast<float>(truncated) ? 1 : 0);
@@ -789,7 +789,8 @@ bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_
       const std::uint32_t end = bin_begin_[row + ub + 1];
       for (std::uint32_t k = bin_begin_[row + ua]; k < end; k += 4) {
         // Four points' distances at once, summed as treeDistanceSq sums them; one not within the limit as it
-        // was before the four is not within it after any of them (it only shrinks). Past end: not read.
+        // was before the four is not within it after any of them (it only shrinks). Lanes past end (the
+        // next bins or the padding) are loaded but skipped.
         const Eigen::Array4f dx = Eigen::Map<const Eigen::Array4f>(bin_x_.data() + k) - query.x();
         const Eigen::Array4f dy = Eigen::Map<const Eigen::Array4f>(bin_y_.data() + k) - query.y();
         const Eigen::Array4f dz = Eigen::Map<const Eigen::Array4f>(bin_z_.data() + k) - query.z();
