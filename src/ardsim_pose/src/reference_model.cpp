@@ -697,45 +697,44 @@ void VisiblePointGrid::build(const ReferenceModel& model, const std::vector<Poin
   bins_high_ = (intrinsics_.height + 2 * pad_px_ + bin_px_ - 1) / bin_px_;
   R_ = T_lidar_target.linear().cast<float>();
   t_ = T_lidar_target.translation().cast<float>();
-  // The points' bins by vectorized array expressions over the ranges (the visible points are tens of
-  // thousands a prediction: 5-6 ns a point, 9 with scalar code), then a counting sort by bin.
-  std::uint32_t longest = 0;
-  for (const auto& [begin, end] : ranges) longest = std::max(longest, end - begin);
-  if (x_.size() < longest) {
-    x_.resize(longest);
-    y_.resize(longest);
-    z_.resize(longest);
-  }
+  // The points' bins in one pass over each range, which GCC vectorizes (the visible points are tens of
+  // thousands a prediction; as four Eigen array passes through scratch arrays it was twice the
+  // instructions), then a counting sort by bin. The same operations in the same order as a point at a time.
   const float inv_bin = 1.0f / bin_px_;
   const float fx = static_cast<float>(intrinsics_.fx) * inv_bin,
               fy = static_cast<float>(intrinsics_.fy) * inv_bin;
   const float cx = (static_cast<float>(intrinsics_.cx) + 0.5f + pad_px_) * inv_bin;
   const float cy = (static_cast<float>(intrinsics_.cy) + 0.5f + pad_px_) * inv_bin;
   const float wide = static_cast<float>(bins_wide_), high = static_cast<float>(bins_high_);
-  const Eigen::ArrayXf& px = model.coordinates(0);
-  const Eigen::ArrayXf& py = model.coordinates(1);
-  const Eigen::ArrayXf& pz = model.coordinates(2);
+  const float* px = model.coordinates(0).data();
+  const float* py = model.coordinates(1).data();
+  const float* pz = model.coordinates(2).data();
+  const float r00 = R_(0, 0), r01 = R_(0, 1), r02 = R_(0, 2), r10 = R_(1, 0), r11 = R_(1, 1),
+              r12 = R_(1, 2), r20 = R_(2, 0), r21 = R_(2, 1), r22 = R_(2, 2);
+  const float tx = t_(0), ty = t_(1), tz = t_(2);
   // Every point goes into a bin of the grid with a border of one bin around it: those beyond the padded
   // image into the border, which no search reads.
-  const Eigen::Index stride = bins_wide_ + 2;
+  const int stride = bins_wide_ + 2;
   std::size_t total = 0;
   for (const auto& [begin, end] : ranges) total += end - begin;
   bin_of_.resize(total);
   std::size_t n = 0;
   for (const auto& [begin, end] : ranges) {
-    const Eigen::Index count = end - begin;
-    const auto X = px.segment(begin, count), Y = py.segment(begin, count), Z = pz.segment(begin, count);
-    auto x = x_.head(count), y = y_.head(count), z = z_.head(count);
-    z = (R_(2, 0) * X + R_(2, 1) * Y + R_(2, 2) * Z + t_(2)).max(kNearestDepthM);
-    // Bin coordinates from the border's corner; >= 0, so the conversion truncates to the floor.
-    x = ((R_(0, 0) * X + R_(0, 1) * Y + R_(0, 2) * Z + t_(0)) * fx / z + (cx + 1.0f))
-            .max(0.0f)
-            .min(wide + 1.0f);
-    y = ((R_(1, 0) * X + R_(1, 1) * Y + R_(1, 2) * Z + t_(1)) * fy / z + (cy + 1.0f))
-            .max(0.0f)
-            .min(high + 1.0f);
-    Eigen::Map<Eigen::ArrayXi>(bin_of_.data() + n, count) =
-        y.cast<int>() * static_cast<int>(stride) + x.cast<int>();
+    const int count = static_cast<int>(end - begin);
+    const float *X = px + begin, *Y = py + begin, *Z = pz + begin;
+    std::int32_t* bin_of = bin_of_.data() + n;
+    for (int k = 0; k < count; ++k) {
+      const float depth = r20 * X[k] + r21 * Y[k] + r22 * Z[k] + tz;
+      const float z = depth < kNearestDepthM ? kNearestDepthM : depth;
+      // Bin coordinates from the border's corner; >= 0, so the conversion truncates to the floor.
+      float x = (r00 * X[k] + r01 * Y[k] + r02 * Z[k] + tx) * fx / z + (cx + 1.0f);
+      float y = (r10 * X[k] + r11 * Y[k] + r12 * Z[k] + ty) * fy / z + (cy + 1.0f);
+      x = x < 0.0f ? 0.0f : x;
+      x = x > wide + 1.0f ? wide + 1.0f : x;
+      y = y < 0.0f ? 0.0f : y;
+      y = y > high + 1.0f ? high + 1.0f : y;
+      bin_of[k] = static_cast<std::int32_t>(y) * stride + static_cast<std::int32_t>(x);
+    }
     n += static_cast<std::size_t>(count);
   }
   bin_begin_.assign(static_cast<std::size_t>(stride) * (bins_high_ + 2) + 1, 0);

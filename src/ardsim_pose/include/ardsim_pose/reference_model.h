@@ -262,7 +262,6 @@ class VisiblePointGrid {
   std::vector<float> bin_x_, bin_y_, bin_z_;  // target frame, bin by bin (by axis: read four at a time)
   std::vector<std::uint32_t> bin_index_;      // their model point indices
   std::vector<std::int32_t> bin_of_;          // scratch: bin per point of the ranges
-  Eigen::ArrayXf x_, y_, z_;                  // scratch
   mutable std::vector<std::pair<float, std::uint32_t>> found_;  // scratch of nearest()
 };
 
