@@ -33,6 +33,30 @@ int floorToInt(float x) {
 
 // Points of a triangle from the R2 low-discrepancy sequence folded into the triangle: even coverage without a
 // random generator, the same model on every run.
+// Depth, image position and radius in pixels of n patches (centres CX, CY, CZ, radii) at T = (R, t), in one
+// pass that GCC vectorizes: the same operations in the same order as one patch at a time, so the same floats.
+void projectPatches(const float* __restrict CX, const float* __restrict CY, const float* __restrict CZ,
+                    const float* __restrict radii, int n, const Eigen::Matrix3f& R, const Eigen::Vector3f& t,
+                    float fx, float fy, float cx, float cy, float* __restrict z, float* __restrict u,
+                    float* __restrict v, float* __restrict radius_px) {
+  const float r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2),
+              r20 = R(2, 0), r21 = R(2, 1), r22 = R(2, 2);
+  const float tx = t.x(), ty = t.y(), tz = t.z();
+  // A 1 the compiler cannot see: with a constant numerator it turns 1 / max(z, 0.05) into a branch between two
+  // divisions (one of which may trap, so not vectorized).
+  const volatile float opaque_one = 1.0f;
+  const float one = opaque_one;
+  for (int k = 0; k < n; ++k) {
+    const float depth = r20 * CX[k] + r21 * CY[k] + r22 * CZ[k] + tz;
+    // 1 / z where z >= 0.05 (the others are skipped by the caller).
+    const float inv_z = one / std::max(depth, 0.05f);
+    z[k] = depth;
+    u[k] = fx * (r00 * CX[k] + r01 * CY[k] + r02 * CZ[k] + tx) * inv_z + cx;
+    v[k] = fy * (r10 * CX[k] + r11 * CY[k] + r12 * CZ[k] + ty) * inv_z + cy;
+    radius_px[k] = radii[k] * fx * inv_z;
+  }
+}
+
 void sampleTriangle(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c, int count,
                     std::vector<Eigen::Vector3f>* out) {
   constexpr double kG = 1.32471795724474602596;  // plastic number
@@ -558,29 +582,26 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
     bool outside = false;
     for (const Eigen::Vector3f& plane : planes) outside = outside || plane.dot(c) < -chunk.radius;
     if (outside) continue;
-    // The chunk's patches as arrays: depth and image position by vectorized expressions (the same
-    // operations in the same order as one patch at a time, so the same floats), then patch by patch.
+    // The chunk's patches' depth and image position in one pass, which GCC vectorizes (the same operations
+    // in the same order as one patch at a time, so the same floats), then patch by patch.
     const Eigen::Index begin = chunk.begin, n = chunk.end - chunk.begin;
     if (depth_z_.size() < n) {
-      for (Eigen::ArrayXf* a : {&depth_z_, &inv_z_, &u_, &v_, &radius_px_}) a->resize(n);
+      for (Eigen::ArrayXf* a : {&depth_z_, &u_, &v_, &radius_px_}) a->resize(n);
     }
-    const auto CX = model.patchCentres(0).segment(begin, n), CY = model.patchCentres(1).segment(begin, n),
-               CZ = model.patchCentres(2).segment(begin, n);
-    const auto radii = model.patchRadii().segment(begin, n);
-    auto z = depth_z_.head(n), inv_z = inv_z_.head(n), us = u_.head(n), vs = v_.head(n),
-         radii_px = radius_px_.head(n);
-    z = R(2, 0) * CX + R(2, 1) * CY + R(2, 2) * CZ + t.z();
-    // 1 / z where z >= 0.05 (the others are skipped below).
-    inv_z = 1.0f / z.max(0.05f);
-    us = fx * (R(0, 0) * CX + R(0, 1) * CY + R(0, 2) * CZ + t.x()) * inv_z + cx;
-    vs = fy * (R(1, 0) * CX + R(1, 1) * CY + R(1, 2) * CZ + t.y()) * inv_z + cy;
-    radii_px = radii * fx * inv_z;
+    const float* CX = model.patchCentres(0).data() + begin;
+    const float* CY = model.patchCentres(1).data() + begin;
+    const float* CZ = model.patchCentres(2).data() + begin;
+    const float* radii = model.patchRadii().data() + begin;
+    projectPatches(CX, CY, CZ, radii, static_cast<int>(n), R, t, fx, fy, cx, cy, depth_z_.data(), u_.data(),
+                   v_.data(), radius_px_.data());
+    const float *z = depth_z_.data(), *us = u_.data(), *vs = v_.data(), *radii_px = radius_px_.data();
+    const auto U = u_.head(n), V = v_.head(n), P = radius_px_.head(n);
     // Every patch (back faces and those behind the sensor included) two cells inside the padded image: none
     // needs the bounds test or the clamps below (a floor and a rounding cost less than a cell each).
     const float inner = 2.0f * cell;
     const bool inside =
-        (us - radii_px).minCoeff() >= u_min + inner && (us + radii_px).maxCoeff() <= u_max - inner &&
-        (vs - radii_px).minCoeff() >= v_min + inner && (vs + radii_px).maxCoeff() <= v_max - inner;
+        (U - P).minCoeff() >= u_min + inner && (U + P).maxCoeff() <= u_max - inner &&
+        (V - P).minCoeff() >= v_min + inner && (V + P).maxCoeff() <= v_max - inner;
     const float* NX = model.patchNormals(0).data() + begin;
     const float* NY = model.patchNormals(1).data() + begin;
     const float* NZ = model.patchNormals(2).data() + begin;

@@ -225,7 +225,7 @@ class VisibilityPredictor {
   std::vector<std::uint32_t> visible_patches_;
   std::vector<std::uint8_t> visible_;
   std::vector<PointRange> visible_ranges_;              // the flags set to 1
-  Eigen::ArrayXf depth_z_, inv_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
+  Eigen::ArrayXf depth_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
 };
 
 // The visible model points binned by the pixels they project to at one pose: an exact nearest-visible-point
