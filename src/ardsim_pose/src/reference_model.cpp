@@ -629,8 +629,10 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
           if (!kInside && (u + radius_px < u_min || u - radius_px >= u_max || v + radius_px < v_min ||
                            v - radius_px >= v_max))
             continue;
-          const int cu = floorToInt((u + 0.5f) * inv_cell + offset);
-          const int cv = floorToInt((v + 0.5f) * inv_cell + offset);
+          // Inside, the cell coordinates are at least 2 (two cells inside the padded image): truncation floors.
+          const float cell_u = (u + 0.5f) * inv_cell + offset, cell_v = (v + 0.5f) * inv_cell + offset;
+          const int cu = kInside ? static_cast<int>(cell_u) : floorToInt(cell_u);
+          const int cv = kInside ? static_cast<int>(cell_v) : floorToInt(cell_v);
           // Splat the patch over the cells it covers, so that it hides what is behind it.
           const int radius = std::min(16, static_cast<int>(radius_px * inv_cell + 0.5f));
           const int x0 = kInside ? cu - radius : std::max(0, cu - radius);
