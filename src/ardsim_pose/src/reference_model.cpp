@@ -760,15 +760,18 @@ void VisiblePointGrid::build(const ReferenceModel& model, const std::vector<Poin
     }
     n += static_cast<std::size_t>(count);
   }
-  bin_begin_.assign(static_cast<std::size_t>(stride) * (bins_high_ + 2) + 1, 0);
-  std::uint32_t* counts = bin_begin_.data() + 1;
+  // Counting sort: bin b's count at b + 2, summed, is where bin b begins at b + 1, and filling bin b moves that
+  // to where bin b + 1 begins: then bin_begin_[b] is where bin b begins, with no pass to shift them back.
+  const std::size_t bins = static_cast<std::size_t>(stride) * (bins_high_ + 2);
+  bin_begin_.assign(bins + 2, 0);
+  std::uint32_t* counts = bin_begin_.data() + 2;
   for (std::size_t k = 0; k < n; ++k) ++counts[bin_of_[k]];
-  for (std::size_t b = 1; b < bin_begin_.size(); ++b) bin_begin_[b] += bin_begin_[b - 1];
+  std::uint32_t sum = 0;
+  for (std::size_t b = 2; b < bins + 2; ++b) bin_begin_[b] = sum += bin_begin_[b];
   // Three more than the points: a search reads four at a time.
   for (std::vector<float>* c : {&bin_x_, &bin_y_, &bin_z_}) c->resize(n + 3);
   bin_index_.resize(n);
-  // bin_begin_[b] runs through bin b while filling, and ends where bin b + 1 began.
-  std::uint32_t* next = bin_begin_.data();
+  std::uint32_t* next = bin_begin_.data() + 1;
   const Eigen::Vector3f* points = model.points().data();
   n = 0;
   for (const auto& [begin, end] : ranges) {
@@ -780,8 +783,6 @@ void VisiblePointGrid::build(const ReferenceModel& model, const std::vector<Poin
       bin_index_[slot] = i;
     }
   }
-  for (std::size_t b = bin_begin_.size() - 1; b > 0; --b) bin_begin_[b] = bin_begin_[b - 1];
-  bin_begin_[0] = 0;
 }
 
 bool VisiblePointGrid::nearest(const Eigen::Vector3f& query, float max_distance_sq, int* index,

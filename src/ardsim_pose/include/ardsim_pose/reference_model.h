@@ -258,7 +258,7 @@ class VisiblePointGrid {
   float min_cos_sq_ = 1.0f;  // squared cosine of the off-axis angle of the padded image's corner
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   Eigen::Vector3f t_ = Eigen::Vector3f::Zero();
-  std::vector<std::uint32_t> bin_begin_;      // (bins_wide_ + 2) x (bins_high_ + 2) + 1: a border of one bin
+  std::vector<std::uint32_t> bin_begin_;      // (bins_wide_ + 2) x (bins_high_ + 2) + 2: a border of one bin
   std::vector<float> bin_x_, bin_y_, bin_z_;  // target frame, bin by bin (by axis: read four at a time)
   std::vector<std::uint32_t> bin_index_;      // their model point indices
   std::vector<std::int32_t> bin_of_;          // scratch: bin per point of the ranges
