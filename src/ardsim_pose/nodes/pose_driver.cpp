@@ -83,6 +83,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/boresight_prior_min_deg", &i.boresight_prior_min_deg);
   read(nh, "icp/acquisition_boresight_gate_deg", &i.acquisition_boresight_gate_deg);
   read(nh, "icp/crop_reuse_px", &i.crop_reuse_px);
+  read(nh, "icp/sparse_start_residual_m", &i.sparse_start_residual_m);
   read(nh, "icp/converged_translation_m", &i.converged_translation_m);
   read(nh, "icp/converged_rotation_rad", &i.converged_rotation_rad);
   read(nh, "icp/revisibility_translation_m", &i.revisibility_translation_m);

@@ -39,6 +39,8 @@ void applyTargetDefaults(PoseConfig* config) {
   config->icp.max_points_near = hubble ? 5000 : defaults.icp.max_points_near;
   // Its roll, held at the prediction end-on, follows the few pixels a reused visibility prediction changes.
   config->icp.crop_reuse_px = hubble ? 0.0 : defaults.icp.crop_reuse_px;
+  // Its first tracking frames' roll follows the path a sparse first step takes.
+  config->icp.sparse_start_residual_m = hubble ? 0.0 : defaults.icp.sparse_start_residual_m;
   // Its roll, measured on the solar-array masts from 50 m in, wobbles ~1e-4 rad between iterations (a frame's
   // roll is good to ~1e-3): chasing 1e-5 left most frames DEGRADED "not converged". With 1e-4 (approach
   // datasets, 24 runs, auto): 30-50 m attitude RMS 0.11 -> 0.093 deg mean, within 0.1 deg in 13 -> 17 runs,

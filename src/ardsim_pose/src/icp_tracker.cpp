@@ -27,6 +27,9 @@ constexpr int kSearchStride = 3;
 constexpr int kCoarseStride = 3;
 constexpr double kCoarseFactor = 10.0;
 constexpr int kFineIterations = 3;
+// The first coarse iteration's sparse start (IcpOptions::sparse_start_residual_m): every kSparseFirstStride-th
+// scan point.
+constexpr int kSparseFirstStride = 9;
 // The balls of model points kept per scan point reach this far beyond its nearest (IcpTracker::
 // nearestVisible): wide enough that the iterations after the first few stay inside, narrow enough to hold
 // few points.
@@ -130,6 +133,9 @@ void validate(const IcpOptions& o) {
                 "icp/acquisition_boresight_gate_deg", o.acquisition_boresight_gate_deg, "0 .. 180");
   requireOption(std::isfinite(o.crop_reuse_px) && o.crop_reuse_px >= 0.0 && o.crop_reuse_px <= 4.0,
                 "icp/crop_reuse_px", o.crop_reuse_px, "0 .. 4");
+  requireOption(std::isfinite(o.sparse_start_residual_m) && o.sparse_start_residual_m >= 0.0 &&
+                    o.sparse_start_residual_m <= 1.0,
+                "icp/sparse_start_residual_m", o.sparse_start_residual_m, "0 .. 1");
   requireOption(positive(o.converged_translation_m), "icp/converged_translation_m", o.converged_translation_m,
                 "> 0");
   requireOption(positive(o.converged_rotation_rad), "icp/converged_rotation_rad", o.converged_rotation_rad,
@@ -551,11 +557,16 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
   // Coarse first only where a third of the points is still plenty and the limit leaves room for it.
   bool coarse = stride == 1 && max_iterations > kFineIterations &&
                 static_cast<int>(scan_.size()) >= 2 * kCoarseStride * options_.min_points;
-  selectActive(coarse ? kCoarseStride : stride);
+  // Tracking beyond near_depth_m, the first coarse iteration searches a third of those first (see
+  // kSparseFirstStride), and the rest only when those lie near the model.
+  bool sparse_first = coarse && tracking && !scan_near_ && options_.sparse_start_residual_m > 0.0 &&
+                      static_cast<int>(scan_.size()) >= 2 * kSparseFirstStride * options_.min_points;
+  selectActive(sparse_first ? kSparseFirstStride : coarse ? kCoarseStride : stride);
   Eigen::Isometry3d& T = a.T;
   predictVisibility(T, tracking ? options_.crop_reuse_px : 0.0);  // tracking: the gate's
   Eigen::Isometry3d T_visibility = T;
   for (; a.iterations < max_iterations && !a.converged; ++a.iterations) {
+    if (sparse_first && a.iterations == 1 && coarse) selectActive(kCoarseStride);  // after a sparse step
     const Eigen::Isometry3d moved = T_visibility.inverse() * T;
     if (moved.translation().norm() > options_.revisibility_translation_m ||
         Eigen::AngleAxisd(moved.linear()).angle() > options_.revisibility_rotation_rad) {
@@ -564,7 +575,6 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     }
     const Eigen::Isometry3f T_target_lidar = T.inverse().cast<float>();
     const Eigen::Matrix3d R = T.linear();
-    correspondences_.clear();
     pending_searches_ = 0;  // after the first iteration on a prediction, most answers come from the balls
     if (neighbourhood_generation_ != visibility_generation_) {
       neighbourhoods_.assign(scan_.size(), Neighbourhood{});
@@ -574,31 +584,49 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       pending_searches_ = static_cast<int>(coarse ? scan_.size() : active_.size());
     }
     const float gate_sq = static_cast<float>(gate * gate);
-    std::size_t kept = 0;
-    for (const int k : active_) {
-      const Eigen::Vector3f& s = scan_[k];
-      float distance_sq = 0.0f;
-      const int j = nearestVisible(k, T_target_lidar * s, gate_sq, &distance_sq);
-      if (j < 0) continue;
-      // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
-      // solar arrays, background returns. Searching for it again each iteration is the costliest query.
-      if (tracking) active_[kept++] = k;
-      // The edge rows of a turned array (Hubble's, 4 cm thick, seen obliquely) return ~2 cm off the model's
-      // planes, one whole pixel row at once where the edge lies along it: with their ~6 m levers they turned
-      // the estimate 0.03-0.06 deg about the arrays' in-plane axis over a 0.7 m window of range (noise-free
-      // renders at 49 m). Such pixels do not count against a part that turns; thin structures (masts, booms:
-      // 1-2 pixels) and the rigid parts' edges do.
-      if (scan_on_wide_edge_[k] && model_->pointArticulated(static_cast<std::uint32_t>(j))) continue;
-      Correspondence c;
-      c.scan = s.cast<double>();
-      c.model = T * model_->points()[j].cast<double>();
-      c.normal = R * model_->normals()[j].cast<double>();
-      c.residual = c.normal.dot(c.scan - c.model);
-      c.distance = std::sqrt(static_cast<double>(distance_sq));
-      c.spacing = model_->spacing()[j];
-      correspondences_.push_back(c);
+    const auto correspond = [&] {
+      correspondences_.clear();
+      std::size_t kept = 0;
+      for (const int k : active_) {
+        const Eigen::Vector3f& s = scan_[k];
+        float distance_sq = 0.0f;
+        const int j = nearestVisible(k, T_target_lidar * s, gate_sq, &distance_sq);
+        if (j < 0) continue;
+        // Once tracking, a point with no model point within the (only shrinking) gate stays unmatched: the
+        // solar arrays, background returns. Searching for it again each iteration is the costliest query.
+        if (tracking) active_[kept++] = k;
+        // The edge rows of a turned array (Hubble's, 4 cm thick, seen obliquely) return ~2 cm off the model's
+        // planes, one whole pixel row at once where the edge lies along it: with their ~6 m levers they turned
+        // the estimate 0.03-0.06 deg about the arrays' in-plane axis over a 0.7 m window of range (noise-free
+        // renders at 49 m). Such pixels do not count against a part that turns; thin structures (masts, booms:
+        // 1-2 pixels) and the rigid parts' edges do.
+        if (scan_on_wide_edge_[k] && model_->pointArticulated(static_cast<std::uint32_t>(j))) continue;
+        Correspondence c;
+        c.scan = s.cast<double>();
+        c.model = T * model_->points()[j].cast<double>();
+        c.normal = R * model_->normals()[j].cast<double>();
+        c.residual = c.normal.dot(c.scan - c.model);
+        c.distance = std::sqrt(static_cast<double>(distance_sq));
+        c.spacing = model_->spacing()[j];
+        correspondences_.push_back(c);
+      }
+      if (tracking) active_.resize(kept);
+    };
+    correspond();
+    if (sparse_first && a.iterations == 0) {
+      // Where the sparse points' median plane residual is below sparse_start_residual_m, the prediction is
+      // good and the first step small: search the whole coarse set now (the sparse points answered by their
+      // balls), as with no sparse start. (Not the point distances: far out the model's spacing alone puts
+      // the nearest point centimetres away.)
+      scratch_.clear();
+      for (const Correspondence& c : correspondences_) scratch_.push_back(std::abs(c.residual));
+      if (static_cast<int>(correspondences_.size()) < options_.min_points ||
+          median(&scratch_) < options_.sparse_start_residual_m) {
+        sparse_first = false;
+        selectActive(kCoarseStride);
+        correspond();
+      }
     }
-    if (tracking) active_.resize(kept);
     if (static_cast<int>(correspondences_.size()) < options_.min_points) {
       a.failure = "too few correspondences with the model: " + std::to_string(correspondences_.size()) +
                   " < " + std::to_string(options_.min_points);
@@ -940,6 +968,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   // prior).
   const bool near =
       !acquiring && slots_[current_].valid && visibility().nearestDepth() < options_.near_depth_m;
+  scan_near_ = near;
   const std::size_t count =
       std::min<std::size_t>(gated_.size(), near ? options_.max_points_near : options_.max_points);
   scan_.reserve(count);
