@@ -555,7 +555,8 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
   visible_patches_.clear();
   const float inf = std::numeric_limits<float>::infinity();
   depth_.assign(static_cast<std::size_t>(padded_width_) * padded_height_, inf);
-  candidates_.clear();
+  if (candidates_.size() < model.patches().size()) candidates_.resize(model.patches().size());
+  std::size_t candidate_count = 0;
   const Eigen::Matrix3f R = T_lidar_target.linear().cast<float>();
   const Eigen::Vector3f t = T_lidar_target.translation().cast<float>();
   const Eigen::Vector3f eye = -(R.transpose() * t);  // the sensor, target frame
@@ -655,7 +656,7 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
           const int cell_index = kInside ? cv * padded_width_ + cu
                                          : std::clamp(cv, 0, padded_height_ - 1) * padded_width_ +
                                                std::clamp(cu, 0, padded_width_ - 1);
-          if (with_points) candidates_.push_back({i, cell_index, depth - radii[k]});
+          if (with_points) candidates_[candidate_count++] = {i, cell_index, depth - radii[k]};
         }
       }
     };
@@ -665,7 +666,8 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
       splat(std::false_type{});
   }
   int count = 0;
-  for (const Candidate& candidate : candidates_) {
+  for (std::size_t c = 0; c < candidate_count; ++c) {
+    const Candidate& candidate = candidates_[c];
     // A surface inclined in a cell spans a depth range: allow a few cells' width besides the fixed tolerance.
     const float tolerance =
         std::max(static_cast<float>(options_.depth_tolerance_m), 3.0f * cell * candidate.depth / fx);

@@ -221,6 +221,8 @@ class VisibilityPredictor {
     std::int32_t cell;  // padded grid
     float depth;
   };
+  // Scratch: a prediction's front patches splatted, with their nearest depth (written by index, sized for
+  // every patch once: no capacity check per patch).
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> visible_patches_;
   std::vector<std::uint8_t> visible_;
