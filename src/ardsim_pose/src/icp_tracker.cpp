@@ -27,8 +27,8 @@ constexpr int kSearchStride = 3;
 constexpr int kCoarseStride = 3;
 constexpr double kCoarseFactor = 10.0;
 constexpr int kFineIterations = 3;
-// The first coarse iteration's sparse start (IcpOptions::sparse_start_residual_m): every kSparseFirstStride-th
-// scan point.
+// The first coarse iteration's sparse start (IcpOptions::sparse_start_residual_m): every
+// kSparseFirstStride-th scan point.
 constexpr int kSparseFirstStride = 9;
 // The balls of model points kept per scan point reach this far beyond its nearest (IcpTracker::
 // nearestVisible): wide enough that the iterations after the first few stay inside, narrow enough to hold
@@ -596,10 +596,10 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
         // solar arrays, background returns. Searching for it again each iteration is the costliest query.
         if (tracking) active_[kept++] = k;
         // The edge rows of a turned array (Hubble's, 4 cm thick, seen obliquely) return ~2 cm off the model's
-        // planes, one whole pixel row at once where the edge lies along it: with their ~6 m levers they turned
-        // the estimate 0.03-0.06 deg about the arrays' in-plane axis over a 0.7 m window of range (noise-free
-        // renders at 49 m). Such pixels do not count against a part that turns; thin structures (masts, booms:
-        // 1-2 pixels) and the rigid parts' edges do.
+        // planes, one whole pixel row at once where the edge lies along it: with their ~6 m levers they
+        // turned the estimate 0.03-0.06 deg about the arrays' in-plane axis over a 0.7 m window of range
+        // (noise-free renders at 49 m). Such pixels do not count against a part that turns; thin structures
+        // (masts, booms: 1-2 pixels) and the rigid parts' edges do.
         if (scan_on_wide_edge_[k] && model_->pointArticulated(static_cast<std::uint32_t>(j))) continue;
         Correspondence c;
         c.scan = s.cast<double>();

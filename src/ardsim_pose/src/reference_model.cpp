@@ -42,8 +42,8 @@ void projectPatches(const float* __restrict CX, const float* __restrict CY, cons
   const float r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2),
               r20 = R(2, 0), r21 = R(2, 1), r22 = R(2, 2);
   const float tx = t.x(), ty = t.y(), tz = t.z();
-  // A 1 the compiler cannot see: with a constant numerator it turns 1 / max(z, 0.05) into a branch between two
-  // divisions (one of which may trap, so not vectorized).
+  // A 1 the compiler cannot see: with a constant numerator it turns 1 / max(z, 0.05) into a branch between
+  // two divisions (one of which may trap, so not vectorized).
   const volatile float opaque_one = 1.0f;
   const float one = opaque_one;
   for (int k = 0; k < n; ++k) {
@@ -600,9 +600,8 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
     // Every patch (back faces and those behind the sensor included) two cells inside the padded image: none
     // needs the bounds test or the clamps below (a floor and a rounding cost less than a cell each).
     const float inner = 2.0f * cell;
-    const bool inside =
-        (U - P).minCoeff() >= u_min + inner && (U + P).maxCoeff() <= u_max - inner &&
-        (V - P).minCoeff() >= v_min + inner && (V + P).maxCoeff() <= v_max - inner;
+    const bool inside = (U - P).minCoeff() >= u_min + inner && (U + P).maxCoeff() <= u_max - inner &&
+                        (V - P).minCoeff() >= v_min + inner && (V + P).maxCoeff() <= v_max - inner;
     const float* NX = model.patchNormals(0).data() + begin;
     const float* NY = model.patchNormals(1).data() + begin;
     const float* NZ = model.patchNormals(2).data() + begin;
@@ -630,7 +629,8 @@ int VisibilityPredictor::predict(const ReferenceModel& model, const Eigen::Isome
           if (!kInside && (u + radius_px < u_min || u - radius_px >= u_max || v + radius_px < v_min ||
                            v - radius_px >= v_max))
             continue;
-          // Inside, the cell coordinates are at least 2 (two cells inside the padded image): truncation floors.
+          // Inside, the cell coordinates are at least 2 (two cells inside the padded image): truncation
+          // floors.
           const float cell_u = (u + 0.5f) * inv_cell + offset, cell_v = (v + 0.5f) * inv_cell + offset;
           const int cu = kInside ? static_cast<int>(cell_u) : floorToInt(cell_u);
           const int cv = kInside ? static_cast<int>(cell_v) : floorToInt(cell_v);
@@ -734,8 +734,8 @@ void VisiblePointGrid::build(const ReferenceModel& model, const std::vector<Poin
   const float* px = model.coordinates(0).data();
   const float* py = model.coordinates(1).data();
   const float* pz = model.coordinates(2).data();
-  const float r00 = R_(0, 0), r01 = R_(0, 1), r02 = R_(0, 2), r10 = R_(1, 0), r11 = R_(1, 1),
-              r12 = R_(1, 2), r20 = R_(2, 0), r21 = R_(2, 1), r22 = R_(2, 2);
+  const float r00 = R_(0, 0), r01 = R_(0, 1), r02 = R_(0, 2), r10 = R_(1, 0), r11 = R_(1, 1), r12 = R_(1, 2),
+              r20 = R_(2, 0), r21 = R_(2, 1), r22 = R_(2, 2);
   const float tx = t_(0), ty = t_(1), tz = t_(2);
   // Every point goes into a bin of the grid with a border of one bin around it: those beyond the padded
   // image into the border, which no search reads.
@@ -762,8 +762,9 @@ void VisiblePointGrid::build(const ReferenceModel& model, const std::vector<Poin
     }
     n += static_cast<std::size_t>(count);
   }
-  // Counting sort: bin b's count at b + 2, summed, is where bin b begins at b + 1, and filling bin b moves that
-  // to where bin b + 1 begins: then bin_begin_[b] is where bin b begins, with no pass to shift them back.
+  // Counting sort: bin b's count at b + 2, summed, is where bin b begins at b + 1, and filling bin b moves
+  // that to where bin b + 1 begins: then bin_begin_[b] is where bin b begins, with no pass to shift them
+  // back.
   const std::size_t bins = static_cast<std::size_t>(stride) * (bins_high_ + 2);
   bin_begin_.assign(bins + 2, 0);
   std::uint32_t* counts = bin_begin_.data() + 2;

@@ -226,7 +226,7 @@ class VisibilityPredictor {
   std::vector<Candidate> candidates_;
   std::vector<std::uint32_t> visible_patches_;
   std::vector<std::uint8_t> visible_;
-  std::vector<PointRange> visible_ranges_;              // the flags set to 1
+  std::vector<PointRange> visible_ranges_;      // the flags set to 1
   Eigen::ArrayXf depth_z_, u_, v_, radius_px_;  // scratch: per patch of a chunk
 };
 
