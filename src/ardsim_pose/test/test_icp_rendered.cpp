@@ -58,6 +58,20 @@ class RenderedIcp : public ::testing::Test {
     return error;
   }
 
+  // n noise-free ISS frames of the default sensor closing 1 cm a frame from port distance d_m, with their
+  // truths (the benchmark's frames).
+  static void renderClosing(double d_m, int n, std::vector<OrganizedCloud>* clouds,
+                            std::vector<Eigen::Isometry3d>* truths) {
+    ardsim_lidar::LidarSimulator simulator(ardsim_lidar::SensorOptions{}, ardsim_lidar::NoiseOptions{}, 7);
+    simulator.setTarget(ardsim_description::buildIss());
+    ardsim_lidar::LidarFrame frame;
+    for (int k = 0; k < n; ++k) {
+      truths->push_back(dockingAxisPose(TargetKind::kIss, d_m - 0.01 * k));
+      simulator.simulate(truths->back(), static_cast<std::uint64_t>(k), &frame);
+      clouds->push_back(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
+    }
+  }
+
   static std::shared_ptr<const ReferenceModel> iss_model_;
 };
 std::shared_ptr<const ReferenceModel> RenderedIcp::iss_model_;
@@ -224,17 +238,10 @@ TEST_F(LostFrames, AnotherObjectIsLost) {
 TEST_F(RenderedIcp, WeakDirectionFromAGuessOffAcrossTheLineOfSight) {
   PoseConfig config;
   IcpTracker tracker(iss_model_, ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
-  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
-  simulator.setTarget(ardsim_description::buildIss());
   const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kIss);
-  ardsim_lidar::LidarFrame frame;
   std::vector<OrganizedCloud> clouds;
   std::vector<Eigen::Isometry3d> truths;
-  for (int k = 0; k < 8; ++k) {
-    truths.push_back(dockingAxisPose(TargetKind::kIss, 29.0 - 0.01 * k));
-    simulator.simulate(truths.back(), static_cast<std::uint64_t>(k), &frame);
-    clouds.push_back(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
-  }
+  renderClosing(29.0, 8, &clouds, &truths);
   ASSERT_EQ(tracker.estimate(clouds[0], truths[0]).status, EstimateStatus::kTracking);
   for (int k = 0; k < 8; ++k) {
     SCOPED_TRACE("frame " + std::to_string(k));
@@ -259,17 +266,10 @@ TEST_F(RenderedIcp, SparseStartKeepsTheEstimates) {
   const ardsim_lidar::Intrinsics intrinsics = ardsim_lidar::intrinsicsFor(sparse.sensor);
   IcpTracker with(iss_model_, intrinsics, sparse.icp, sparse.visibility);
   IcpTracker without(iss_model_, intrinsics, dense.icp, dense.visibility);
-  ardsim_lidar::LidarSimulator simulator(sparse.sensor, ardsim_lidar::NoiseOptions{}, 7);
-  simulator.setTarget(ardsim_description::buildIss());
   const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kIss);
-  ardsim_lidar::LidarFrame frame;
   std::vector<OrganizedCloud> clouds;
   std::vector<Eigen::Isometry3d> truths;
-  for (int k = 0; k < 8; ++k) {
-    truths.push_back(dockingAxisPose(TargetKind::kIss, 29.0 - 0.01 * k));
-    simulator.simulate(truths.back(), static_cast<std::uint64_t>(k), &frame);
-    clouds.push_back(fromLidarFrame(frame, simulator.rays(), 0.1 * k));
-  }
+  renderClosing(29.0, 8, &clouds, &truths);
   for (IcpTracker* tracker : {&with, &without})
     ASSERT_EQ(tracker->estimate(clouds[0], truths[0]).status, EstimateStatus::kTracking);
   int iterations_with = 0;
