@@ -1,6 +1,8 @@
 // The estimator facade (PoseEstimator) with scripted methods: the median filter on a steady approach, and
-// what the motion prediction learns from TRACKING, DEGRADED and acquisition estimates; the per-target config.
+// what the motion prediction learns from TRACKING, DEGRADED and acquisition estimates; the per-target config;
+// which points of a frame are returns (isReturn).
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -42,6 +44,23 @@ class ScriptedMethod : public PoseMethod {
   }
   void reset() override {}
 };
+
+// A return is finite in all three coordinates and in front of the sensor (one test for the three: v - v).
+TEST(IsReturn, FiniteAndInFrontOnly) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float huge = std::numeric_limits<float>::max();
+  EXPECT_TRUE(isReturn(Eigen::Vector3f(0.1f, -2.0f, 30.0f)));
+  EXPECT_TRUE(isReturn(Eigen::Vector3f(huge, -huge, huge)));
+  EXPECT_TRUE(isReturn(Eigen::Vector3f(0.0f, 0.0f, 1e-30f)));
+  EXPECT_FALSE(isReturn(Eigen::Vector3f(0.0f, 0.0f, 0.0f)));
+  EXPECT_FALSE(isReturn(Eigen::Vector3f(0.0f, 0.0f, -1.0f)));
+  for (const float bad : {inf, -inf, nan}) {
+    EXPECT_FALSE(isReturn(Eigen::Vector3f(bad, 0.0f, 10.0f))) << bad;
+    EXPECT_FALSE(isReturn(Eigen::Vector3f(0.0f, bad, 10.0f))) << bad;
+    EXPECT_FALSE(isReturn(Eigen::Vector3f(0.0f, 0.0f, bad))) << bad;
+  }
+}
 
 TEST(PoseEstimatorMedianFilter, NeitherLagsASteadyApproachNorPassesAnOutlier) {
   EstimatorOptions options;

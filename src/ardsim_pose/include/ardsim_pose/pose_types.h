@@ -20,9 +20,10 @@ struct OrganizedCloud {
 };
 
 // Whether a point of such a frame is a return: finite and in front of the sensor. (z first: most pixels of
-// a far target's frame have none, and the test runs on every pixel of every frame.)
+// a far target's frame have none, and the test runs on every pixel of every frame. Then one test for all
+// three finite: v - v is 0 for a finite v and NaN for an infinite or NaN one.)
 inline bool isReturn(const Eigen::Vector3f& p) {
-  return p.z() > 0.0f && std::isfinite(p.z()) && std::isfinite(p.x()) && std::isfinite(p.y());
+  return p.z() > 0.0f && (p.x() - p.x()) + (p.y() - p.y()) + (p.z() - p.z()) == 0.0f;
 }
 
 enum class EstimateStatus { kTracking, kDegraded, kLost };
