@@ -67,9 +67,8 @@ void applyTargetDefaults(PoseConfig* config) {
   // measured on the masts at 30-50 m, is good to ~0.025 deg when a row of pixels falls on a mast's grazing
   // side and to ~0.07 when not, which changes with the sub-pixel phase over seconds; averaged longer, the
   // same five seeds 0.019-0.022 -> 0.016-0.017 deg, worst frame 0.051-0.10 -> 0.038-0.055 (a 2 deg roll
-  // offset at the start, turning at 0.05 deg/s: seed 2 0.020 -> 0.016, worst 0.076 -> 0.043).
-  config->icp.boresight_prior_frames = hubble ? 36 : defaults.icp.boresight_prior_frames;
-  config->icp.boresight_prior_min_deg = hubble ? 0.01 : defaults.icp.boresight_prior_min_deg;
+  // offset at the start, turning at 0.05 deg/s: seed 2 0.020 -> 0.016, worst 0.076 -> 0.043). These are
+  // the defaults (IcpOptions::boresight_prior_frames), the ISS's too since session 32.
   // Its aft bulkhead face-on leaves ICP's planes blind across it: its rim's occluding contours place it
   // (IcpOptions::contour_sigma_px; approach datasets, 24 runs, 30-50 m: port position RMS 0.8-2.3 ->
   // 0.18-0.44 cm, worst frame 5.0 -> 0.84 cm, attitude RMS 0.019-0.045 -> 0.021-0.042 deg, both within 3x in
