@@ -70,7 +70,7 @@ struct IcpOptions {
   // ... and once tracking for more than boresight_prior_frames frames in a row (0: never), that prior
   // tightens as 1 / sqrt(the frames tracked), down to boresight_prior_min_deg: the held rotation is an
   // average over them by then. It sits at the constant-rate prediction: a steady turn is followed, only a
-  // change of rate lags. Hubble since session 17 (on its masts, arrays edge-on, frames at 30-50 m fit the
+  // change of rate lags. Hubble since session 19 (on its masts, arrays edge-on, frames at 30-50 m fit the
   // roll 0.4-0.5 deg off for seconds on end, and the 0.05 deg prior followed; tight from the start, it held
   // an acquisition's 1 deg error through the 0.5 m a frame approach datasets), the ISS since session 32
   // (inside ~8 m its docking adapter leaves the roll to a few asymmetric features: with the prior at 0.2 deg
