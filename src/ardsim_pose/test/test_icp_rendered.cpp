@@ -436,12 +436,11 @@ TEST(IssHandOver, CompositeTakesIcpRollWhereTheRingsIsWeak) {
   EXPECT_LT(composite_deg, 0.75 * ring_deg) << ring_deg;  // measured 0.038
 }
 
-// ICP alone closing on the ISS's docking adapter from 13 to 7 m (lidar to port), noise on, 2 cm a 0.1 s frame
-// from the truth at the first:
-// inside ~8 m (lidar to port) the roll about the boresight rests on a few asymmetric features and is held
-// near its prediction; tightened once tracked for icp/boresight_prior_frames (36) frames, the held roll
-// averages over the frames instead of following each frame's fit. Returns the attitude RMS at 7-8 m (lidar to
-// port).
+// ICP alone closing on the ISS's docking adapter from 13 to 7 m (lidar to port), noise on, 2 cm a 0.1 s
+// frame, from the truth at the first. Inside ~8 m the roll about the boresight rests on a few asymmetric
+// features and is held near its prediction; with the prior tightened once tracked for
+// icp/boresight_prior_frames frames, the held roll averages over the frames instead of following each frame's
+// fit. Returns the attitude RMS at 7-8 m.
 double issAdapterAttitudeRmsDeg(int boresight_prior_frames) {
   PoseConfig config;
   config.method = "icp";
