@@ -62,6 +62,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "visibility/cell_px", &c.visibility.cell_px);
   read(nh, "visibility/margin_px", &c.visibility.margin_px);
   read(nh, "visibility/depth_tolerance_m", &c.visibility.depth_tolerance_m);
+  read(nh, "visibility/max_incidence_deg", &c.visibility.max_incidence_deg);
   IcpOptions& i = c.icp;
   read(nh, "icp/max_points", &i.max_points);
   read(nh, "icp/max_points_near", &i.max_points_near);
@@ -76,6 +77,9 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/weak_direction_condition", &i.weak_direction_condition);
   read(nh, "icp/degraded_weak_slide_px", &i.degraded_weak_slide_px);
   read(nh, "icp/contour_sigma_px", &i.contour_sigma_px);
+  read(nh, "icp/contours_for_boresight", &i.contours_for_boresight);
+  read(nh, "icp/max_contour_pairs", &i.max_contour_pairs);
+  read(nh, "icp/contour_wait_px", &i.contour_wait_px);
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/boresight_prior_deg", &i.boresight_prior_deg);
   read(nh, "icp/boresight_prior_max_information", &i.boresight_prior_max_information);

@@ -27,6 +27,9 @@ constexpr int kSearchStride = 3;
 constexpr int kCoarseStride = 3;
 constexpr double kCoarseFactor = 10.0;
 constexpr int kFineIterations = 3;
+// How far along a contour pair's line the model's contour is looked for, px (OccludingContours' default
+// window): also Tukey's limit of the contours' offsets (beyond it no pair counts anyway).
+constexpr double kContourWindowPx = 3.0;
 // The first coarse iteration's sparse start (IcpOptions::sparse_start_residual_m): every
 // kSparseFirstStride-th scan point.
 constexpr int kSparseFirstStride = 9;
@@ -115,6 +118,10 @@ void validate(const IcpOptions& o) {
                 "> 0");
   requireOption(std::isfinite(o.contour_sigma_px) && o.contour_sigma_px >= 0.0 && o.contour_sigma_px <= 10.0,
                 "icp/contour_sigma_px", o.contour_sigma_px, "0 .. 10");
+  requireOption(o.max_contour_pairs >= 0 && o.max_contour_pairs <= 1000000, "icp/max_contour_pairs",
+                o.max_contour_pairs, "0 .. 1000000");
+  requireOption(std::isfinite(o.contour_wait_px) && o.contour_wait_px >= 0.0 && o.contour_wait_px <= 100.0,
+                "icp/contour_wait_px", o.contour_wait_px, "0 .. 100");
   requireOption(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
   requireOption(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
@@ -186,7 +193,7 @@ IcpTracker::IcpTracker(std::shared_ptr<const ReferenceModel> model,
       intrinsics_(intrinsics),
       options_(options),
       slots_{VisibilitySlot(intrinsics, visibility), VisibilitySlot(intrinsics, visibility)},
-      contours_(intrinsics) {
+      contours_(intrinsics, options.max_contour_pairs) {
   validate(options_);
   if (!model_) throw std::invalid_argument("IcpTracker: no reference model");
   // The cell of each pixel column once (the frame's width is the sensor's, checked per frame), not two
@@ -371,9 +378,8 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, E
     contour_generation_ = visibility_generation_;
     T_contours_ = a.T;
   }
-  constexpr double kContourLimitPx = 3.0;  // Tukey's limit: the window (beyond it no pair counts anyway)
   return contours_.accumulate(with_boresight_rotation, a.T, a.centre, a.limit_m / options_.tukey_c,
-                              options_.contour_sigma_px, kContourLimitPx, H, g) > 0;
+                              options_.contour_sigma_px, kContourWindowPx, H, g) > 0;
 }
 
 double IcpTracker::weakestOfFive(const Eigen::Matrix<double, 6, 6>& H_scaled) const {
@@ -419,8 +425,11 @@ double IcpTracker::imageMotionPx(const Eigen::Isometry3d& T_a, const Eigen::Isom
 }
 
 void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_px, bool depth_only) {
+  // Acquiring, from a pose good to ~10 deg, the surfaces seen too obliquely to return are not known: a
+  // crop without them lost the ISS from the coarse prior at 9 m (VisibilityOptions::max_incidence_deg).
+  const bool oblique = acquiring_;
   auto serves = [&](const VisibilitySlot& slot) {
-    return slot.valid && (depth_only || !slot.depth_only) &&
+    return slot.valid && (depth_only || (!slot.depth_only && slot.oblique == oblique)) &&
            (T.matrix() == slot.pose.matrix() ||
             (tolerance_px > 0.0 &&
              imageMotionPx(slot.pose, T, slot.predictor.nearestDepth()) <= tolerance_px));
@@ -430,10 +439,11 @@ void IcpTracker::predictVisibility(const Eigen::Isometry3d& T, double tolerance_
   ++visibility_generation_;
   VisibilitySlot& slot = slots_[current_];
   if (serves(slot)) return;
-  slot.visible_points = slot.predictor.predict(*model_, T, !depth_only);
+  slot.visible_points = slot.predictor.predict(*model_, T, !depth_only, oblique);
   slot.pose = T;
   slot.valid = true;
   slot.depth_only = depth_only;
+  slot.oblique = oblique;
   slot.grid_built = false;
   slot.tree_searches = 0;
 }
@@ -565,6 +575,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
   Eigen::Isometry3d& T = a.T;
   predictVisibility(T, tracking ? options_.crop_reuse_px : 0.0);  // tracking: the gate's
   Eigen::Isometry3d T_visibility = T;
+  bool contours_on = contoursFromStart(T_start, tracking);
   for (; a.iterations < max_iterations && !a.converged; ++a.iterations) {
     if (sparse_first && a.iterations == 1 && coarse) selectActive(kCoarseStride);  // after a sparse step
     const Eigen::Isometry3d moved = T_visibility.inverse() * T;
@@ -689,9 +700,10 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     // frame 1.7 deg off without): tracking, it stays the planes' and the prior's, which average it over
     // frames; the contours' sub-pixel errors last for frames in a slow approach (hubble_hold, lidar seeds 2 /
     // 23: ICP 30-50 m attitude RMS 0.030 / 0.032 deg with them, 0.021 / 0.024 without).
-    if (options_.contour_sigma_px > 0.0 &&
+    if (options_.contour_sigma_px > 0.0 && contours_on &&
         (weakestOfFive(H_scaled) < options_.weak_direction_condition * largest ||
-         boresight_information < options_.boresight_prior_max_information) &&
+         (options_.contours_for_boresight &&
+          boresight_information < options_.boresight_prior_max_information)) &&
         addContours(a, !tracking, &H, &g)) {
       H_scaled = leverScaled(H, a.centre);
       largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
@@ -735,6 +747,8 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
     if (w.norm() > 0.0) step.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
     step.translation() = a.centre + v - step.linear() * a.centre;
+    contours_on =
+        contours_on || imageMotionPx(T, step * T, visibility().nearestDepth()) < options_.contour_wait_px;
     T = step * T;
     if (coarse) {
       if ((v.norm() < kCoarseFactor * options_.converged_translation_m &&
@@ -811,6 +825,14 @@ IcpTracker::Alignment IcpTracker::bestOf(const std::vector<Eigen::Isometry3d>& h
     }
   }
   return best;
+}
+
+bool IcpTracker::contoursFromStart(const Eigen::Isometry3d& T_start, bool tracking) const {
+  // A prediction within the contours' window of a TRACKING estimate finds its model contours there (the
+  // closed loop's are millimetres off); others wait for a small step (IcpOptions::contour_wait_px).
+  return options_.contour_wait_px <= 0.0 ||
+         (tracking && last_tracking_ &&
+          imageMotionPx(T_last_, T_start, visibility().nearestDepth()) < kContourWindowPx);
 }
 
 double IcpTracker::trackingBoresightPriorRad() const {
@@ -910,6 +932,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
   result.acquiring = acquiring;
   auto lost = [&](const std::string& reason) {
     tracked_frames_ = 0;
+    last_tracking_ = false;
     result.status = EstimateStatus::kLost;
     result.reason = reason;
     result.covariance.setZero();
@@ -1100,6 +1123,8 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
     if (acquired_.size() > 2) acquired_.erase(acquired_.begin());
   }
   tracked_frames_ = acquiring ? 0 : tracked_frames_ + 1;
+  T_last_ = T;
+  last_tracking_ = !acquiring && degraded.empty();
   if (degraded.empty()) {
     result.status = EstimateStatus::kTracking;
     acquiring_ = false;

@@ -27,9 +27,12 @@ int pixelOf(float coordinate) {
 }
 }  // namespace
 
-OccludingContours::OccludingContours(const ardsim_lidar::Intrinsics& intrinsics, double depth_jump_m,
-                                     int window_px)
-    : intrinsics_(intrinsics), depth_jump_m_(static_cast<float>(depth_jump_m)), window_px_(window_px) {}
+OccludingContours::OccludingContours(const ardsim_lidar::Intrinsics& intrinsics, int max_pairs,
+                                     double depth_jump_m, int window_px)
+    : intrinsics_(intrinsics),
+      depth_jump_m_(static_cast<float>(depth_jump_m)),
+      window_px_(window_px),
+      max_pairs_(max_pairs) {}
 
 void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<int>& pixels) {
   const int w = cloud.width, h = cloud.height;
@@ -91,6 +94,18 @@ void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<i
       if (u < 0 || v < 0 || !pair_at_[slot(p, u, v)]) break;
       ++p.run;
     }
+  }
+  // Every k-th pair (their runs counted on all of them): each is searched for at every iteration, and the
+  // ISS's docking adapter at 6-16 m gives ~5000.
+  const std::size_t count = pairs_.size();
+  if (max_pairs_ > 0 && count > static_cast<std::size_t>(max_pairs_)) {
+    kept_.clear();
+    for (std::size_t k = 0; k < static_cast<std::size_t>(max_pairs_); ++k)
+      kept_.push_back(pairs_[k * count / max_pairs_]);
+    pairs_.swap(kept_);
+    column_has_pair_.assign(w, 0);
+    row_has_pair_.assign(h, 0);
+    for (const Pair& p : pairs_) (p.dv != 0 ? column_has_pair_[p.u] : row_has_pair_[p.v]) = 1;
   }
 }
 

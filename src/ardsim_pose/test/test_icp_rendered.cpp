@@ -5,9 +5,11 @@
 // along a weakly observed direction, with and without the sparse start.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -278,8 +280,7 @@ TEST_F(RenderedIcp, SparseStartKeepsTheEstimates) {
     }
   };
   ASSERT_NO_FATAL_FAILURE(startTracking());
-  int iterations_with = 0;
-  int iterations_without = 0;
+  std::vector<int> iterations_with, iterations_without;
   for (int k = 0; k < 8; ++k) {
     SCOPED_TRACE("off, frame " + std::to_string(k));
     const Eigen::Isometry3d guess =
@@ -288,8 +289,8 @@ TEST_F(RenderedIcp, SparseStartKeepsTheEstimates) {
     const PoseResult b = without.estimate(clouds[k], guess);
     EXPECT_EQ(a.status, EstimateStatus::kTracking) << a.reason;
     EXPECT_EQ(b.status, EstimateStatus::kTracking) << b.reason;
-    iterations_with += a.iterations;
-    iterations_without += b.iterations;
+    iterations_with.push_back(a.iterations);
+    iterations_without.push_back(b.iterations);
     const PoseErrorValue difference = poseError(a.T_lidar_target, b.T_lidar_target, T_target_port);
     EXPECT_LT(difference.port_position_error_m.norm(), 0.001);
     EXPECT_LT(difference.attitude_error_angle_rad * 180.0 / M_PI, 0.005);
@@ -297,7 +298,9 @@ TEST_F(RenderedIcp, SparseStartKeepsTheEstimates) {
     EXPECT_LT(error.port_position_error_m.norm(), 0.02);
     EXPECT_LT(error.attitude_error_angle_rad * 180.0 / M_PI, 0.05);
   }
-  // It did start sparse: the iterations differ (fewer, in the benchmark's frames: 7.8 against 8.6).
+  // It did start sparse: the frames' iterations differ (in the benchmark's frames 7.8 against 8.6 on average
+  // until session 33; since its crop leaves out the walls seen too obliquely, these eight frames' sums
+  // happen to be equal, 59 each).
   EXPECT_NE(iterations_with, iterations_without);
   // Again: the frames above left the two trackers' motion and crops apart.
   ASSERT_NO_FATAL_FAILURE(startTracking());
@@ -471,6 +474,55 @@ TEST(IssCloseApproach, TightenedBoresightPriorMeetsTheAttitudeGoal) {
   EXPECT_LT(tightened_deg, 0.05);
   EXPECT_LT(tightened_deg, 0.75 * held_deg) << held_deg;
   std::printf("7-8 m attitude RMS: tightened %.4f deg, held at 0.2 deg %.4f deg\n", tightened_deg, held_deg);
+}
+
+// ICP alone closing on the ISS's docking adapter from 11 to 6 m (lidar to port), noise on, 2 cm a 0.1 s
+// frame, from the truth at the first, with max_incidence_deg and contour_sigma_px as given. At 7-10 m the
+// adapter's face seen end-on measures the port across the boresight only at its rims. Returns the port
+// position error's mean across the boresight (lidar x) and its RMS (all axes), m, at 7-10 m.
+std::pair<double, double> issAdapterLateralErrorM(double max_incidence_deg, double contour_sigma_px) {
+  PoseConfig config;
+  config.method = "icp";
+  applyTargetDefaults(&config);
+  config.visibility.max_incidence_deg = max_incidence_deg;
+  config.icp.contour_sigma_px = contour_sigma_px;
+  ardsim_lidar::NoiseOptions noise;
+  noise.enabled = true;
+  AlongTheDockingAxis iss(config, ardsim_description::buildIss(), 5, 0.1, noise);
+  double sum_x = 0.0, sum_sq = 0.0;
+  int count = 0;
+  for (int k = 0; k <= 250; ++k) {
+    const double port_m = 10.0 - 0.02 * k;  // port to port: the lidar is 1 m behind the chaser's port
+    PoseErrorValue e;
+    const EstimatorOutput out = iss.frame(k, port_m, &e);
+    EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
+    if (e.range_m >= 10.0 || e.range_m < 7.0) continue;
+    sum_x += e.port_position_error_m.x();
+    sum_sq += e.port_position_error_m.squaredNorm();
+    ++count;
+  }
+  EXPECT_GE(count, 140);
+  return {sum_x / std::max(1, count), std::sqrt(sum_sq / std::max(1, count))};
+}
+
+// The sensor returns nothing from a surface it sees beyond 80 deg incidence: the walls of the docking adapter
+// seen end-on. Kept in the visibility crop, the scan points at the rim of its face matched them, and the port
+// came out 6-8 mm off across the boresight on average (position RMS 8-10 mm at 7-10 m). Left out, the rims
+// are placed by the occluding contours.
+TEST(IssCloseApproach, ObliqueWallsLeftOutAndContoursPlaceThePortAcrossTheBoresight) {
+  const PoseConfig defaults;
+  ASSERT_LT(defaults.visibility.max_incidence_deg, 90.0);
+  ASSERT_GT(defaults.icp.contour_sigma_px, 0.0);
+  const auto [mean_x_m, rms_m] =
+      issAdapterLateralErrorM(defaults.visibility.max_incidence_deg, defaults.icp.contour_sigma_px);
+  const auto [mean_x_before_m, rms_before_m] = issAdapterLateralErrorM(90.0, 0.0);
+  EXPECT_LT(std::abs(mean_x_m), 0.002);
+  EXPECT_LT(rms_m, 0.004);
+  EXPECT_LT(rms_m, 0.5 * rms_before_m);
+  std::printf(
+      "7-10 m port error across the boresight, mean: %.2f mm (before %.2f); position RMS %.2f mm (before "
+      "%.2f)\n",
+      mean_x_m * 1e3, mean_x_before_m * 1e3, rms_m * 1e3, rms_before_m * 1e3);
 }
 
 // Hubble (its arrays edge-on) along its docking axis with Hubble's defaults, 0.1 s a frame.

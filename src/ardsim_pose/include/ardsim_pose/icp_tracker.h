@@ -54,9 +54,23 @@ struct IcpOptions {
   // (OccludingContours: pairs of pixels across a depth edge, the model's contour between their centres),
   // which place a rim to a fraction of a pixel where the offsets stop at half one (and, while acquiring, the
   // roll by the edges of off-axis structure: Hubble's masts): the contour's standard deviation in pixels
-  // (half a pixel either way, evenly: 0.29, and the model's sampling). 0: the planes (and offsets) alone. By
-  // target: 0 (the ISS), 0.3 (Hubble; applyTargetDefaults says why).
-  double contour_sigma_px = 0.0;
+  // (half a pixel either way, evenly: 0.29, and the model's sampling). 0: the planes (and offsets) alone.
+  // Both targets (the ISS since session 33; applyTargetDefaults says why).
+  double contour_sigma_px = 0.3;
+  // Whether a barely observed boresight rotation alone calls for the contours too. By target: false (the
+  // ISS: inside 2 m, where its roll is barely observed, the contours of the docking port's inside kept most
+  // ICP-alone frames from converging, and the guidance held), true (Hubble).
+  bool contours_for_boresight = false;
+  // At most this many contour pairs a frame (evenly spread; 0: all): each is searched for at every
+  // iteration. By target: 500 (the ISS: its docking adapter at 6-16 m gives ~5000, and 500 place its rims
+  // within ~1 mm RMS), 0 (Hubble).
+  int max_contour_pairs = 500;
+  // A tracking frame whose prediction lies beyond the contours' window (3 px) of the last TRACKING estimate,
+  // and an acquisition's alignment, take the contours only after an iteration whose step moved the model
+  // less than this many pixels: from the benchmark's predictions, 0.2 m off at 10 m, the window holds other
+  // edges, and the contours held the pose there (13-16 cm off). 0: from the first iteration. By target: 1.5
+  // (the ISS), 0 (Hubble).
+  double contour_wait_px = 1.5;
   double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
   // Tracking: the rotation about the boresight is held near the prediction with this standard deviation
   // (deg; a prior in the normal equations): where the scan barely observes it (a near-symmetric docking
@@ -153,6 +167,7 @@ class IcpTracker : public PoseMethod {
     acquiring_ = true;
     acquired_.clear();
     tracked_frames_ = 0;
+    last_tracking_ = false;
   }
 
   bool acquiring() const { return acquiring_; }
@@ -186,6 +201,9 @@ class IcpTracker : public PoseMethod {
   Alignment align(const Eigen::Isometry3d& T_start, double gate_m, int max_iterations, bool tracking,
                   int stride, const Eigen::Isometry3d* T_boresight_prior = nullptr);
   Alignment acquire(const Eigen::Isometry3d& T_prior);
+  // Whether an alignment from T_start (tracking) may take the contours from its first iteration
+  // (IcpOptions::contour_wait_px).
+  bool contoursFromStart(const Eigen::Isometry3d& T_start, bool tracking) const;
   // The boresight prior's standard deviation this tracking frame (IcpOptions::boresight_prior_*), rad.
   double trackingBoresightPriorRad() const;
   // Of the hypotheses, each aligned for search_iterations, the one that explains most scan points (of those
@@ -272,10 +290,14 @@ class IcpTracker : public PoseMethod {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     bool valid = false;
     bool depth_only = false;  // visible and grid not made
+    bool oblique = false;     // made while acquiring: oblique patches count as visible
   };
   std::array<VisibilitySlot, 2> slots_;
   int current_ = 0;
   bool acquiring_ = true;
+  // The last frame's estimate, and whether it was a TRACKING one (IcpOptions::contour_wait_px).
+  Eigen::Isometry3d T_last_ = Eigen::Isometry3d::Identity();
+  bool last_tracking_ = false;
   int tracked_frames_ = 0;  // tracking frames in a row before this one (IcpOptions::boresight_prior_frames)
   std::vector<std::pair<double, Eigen::Isometry3d>>
       acquired_;  // (stamp s, pose) of the last acquisition frames

@@ -24,9 +24,11 @@ namespace ardsim_pose {
 
 class OccludingContours {
  public:
-  // depth_jump_m: a neighbour at least this much farther (or with no return) is across an edge; window_px:
-  // how far along the pair's line the model's contour is looked for (beyond it the pair is not used).
-  OccludingContours(const ardsim_lidar::Intrinsics& intrinsics, double depth_jump_m = 0.3, int window_px = 3);
+  // max_pairs: at most this many pairs a frame, evenly spread over them (0: all); depth_jump_m: a neighbour
+  // at least this much farther (or with no return) is across an edge; window_px: how far along the pair's
+  // line the model's contour is looked for (beyond it the pair is not used).
+  explicit OccludingContours(const ardsim_lidar::Intrinsics& intrinsics, int max_pairs = 0,
+                             double depth_jump_m = 0.3, int window_px = 3);
 
   // The edge pairs of a frame whose returns are among pixels (indices into cloud.points).
   void extract(const OrganizedCloud& cloud, const std::vector<int>& pixels);
@@ -78,7 +80,9 @@ class OccludingContours {
   ardsim_lidar::Intrinsics intrinsics_;
   float depth_jump_m_;
   int window_px_;
+  int max_pairs_;
   std::vector<Pair> pairs_;
+  std::vector<Pair> kept_;                    // scratch: the pairs kept of max_pairs_
   std::vector<float> depth_;                  // scratch: per pixel, +inf where no return
   std::vector<std::uint8_t> near_saturated_;  // scratch: per pixel, within the bloom of a saturated return
   std::vector<std::uint8_t> pair_at_;         // scratch: per pixel and direction, a pair there

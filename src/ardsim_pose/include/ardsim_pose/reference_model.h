@@ -175,6 +175,10 @@ struct VisibilityOptions {
   double margin_px = 12.0;  // points this far outside the image still count (the prediction is not exact)
   double depth_tolerance_m =
       0.2;  // a point within this (or 3 cells' width) behind the nearest surface is seen
+  // The lidar returns nothing from a surface it sees more obliquely than this (its noise model's
+  // max_incidence_deg; must match it): such patches still hide what is behind them, but are left out of the
+  // visible points, which no scan point can lie on (90: back faces only).
+  double max_incidence_deg = 80.0;
 };
 void validate(const VisibilityOptions& options);
 
@@ -187,7 +191,10 @@ class VisibilityPredictor {
   // The per-cell depth of the nearest predicted surface and, with_points, which model points are visible
   // (visible()). Returns the number of visible points; without points the depths alone (no visibility test
   // per patch), 0.
-  int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target, bool with_points = true);
+  // oblique: patches seen more obliquely than max_incidence_deg count as visible too (a pose that is only
+  // roughly known, whose incidences are not).
+  int predict(const ReferenceModel& model, const Eigen::Isometry3d& T_lidar_target, bool with_points = true,
+              bool oblique = false);
   // One flag per point of the model of the last predict(); all 0 after one without points.
   const std::vector<std::uint8_t>& visible() const { return visible_; }
 
@@ -211,6 +218,7 @@ class VisibilityPredictor {
   int grid_width_ = 0;
   int grid_height_ = 0;
   int margin_cells_ = 0;
+  float cos_max_incidence_sq_ = 0.0f;  // squared cosine of max_incidence_deg; 0: no grazing test
   int padded_width_ = 0;
   int padded_height_ = 0;
   std::vector<float> depth_;        // padded grid
