@@ -77,11 +77,13 @@ void applyTargetDefaults(PoseConfig* config) {
   // sees too obliquely to return (VisibilityOptions::max_incidence_deg), takes them too since session 33
   // (the fine approach datasets, 16 -> 6 m: 7-10 m port position RMS 8-10 -> 1-1.2 mm), but never its
   // roll (contours_for_boresight: inside 2 m the docking port's inner contours kept ICP-alone frames from
-  // converging), at most 500 pairs a frame (speed), and from a prediction far off only after a small step
-  // (contour_wait_px); Hubble as tuned before (all pairs, from the first iteration, its roll too).
+  // converging), at most 500 pairs a frame (speed), from a prediction far off only after a small step
+  // (contour_wait_px), and inside 12 m only (contour_max_depth_m); Hubble as tuned before (all pairs, from
+  // the first iteration, at any range, its roll too).
   config->icp.contours_for_boresight = hubble;
   config->icp.max_contour_pairs = hubble ? 0 : defaults.icp.max_contour_pairs;
   config->icp.contour_wait_px = hubble ? 0.0 : defaults.icp.contour_wait_px;
+  config->icp.contour_max_depth_m = hubble ? 0.0 : defaults.icp.contour_max_depth_m;
   // Hubble end-on gives ICP little (a face-on bulkhead, the roll on a few edges: 1.6-2.2 cm and 0.11-0.43
   // deg RMS at 10-20 m on the approach datasets) while the docking ring is found from 20 m (its bulkhead then
   // fills a quarter of the view): the close-range method takes over there (10-20 m: 0.3-0.6 cm, 0.05-0.10

@@ -122,6 +122,8 @@ void validate(const IcpOptions& o) {
                 o.max_contour_pairs, "0 .. 1000000");
   requireOption(std::isfinite(o.contour_wait_px) && o.contour_wait_px >= 0.0 && o.contour_wait_px <= 100.0,
                 "icp/contour_wait_px", o.contour_wait_px, "0 .. 100");
+  requireOption(std::isfinite(o.contour_max_depth_m) && o.contour_max_depth_m >= 0.0,
+                "icp/contour_max_depth_m", o.contour_max_depth_m, ">= 0");
   requireOption(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
   requireOption(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
@@ -701,6 +703,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     // frames; the contours' sub-pixel errors last for frames in a slow approach (hubble_hold, lidar seeds 2 /
     // 23: ICP 30-50 m attitude RMS 0.030 / 0.032 deg with them, 0.021 / 0.024 without).
     if (options_.contour_sigma_px > 0.0 && contours_on &&
+        (options_.contour_max_depth_m <= 0.0 || visibility().nearestDepth() < options_.contour_max_depth_m) &&
         (weakestOfFive(H_scaled) < options_.weak_direction_condition * largest ||
          (options_.contours_for_boresight &&
           boresight_information < options_.boresight_prior_max_information)) &&
