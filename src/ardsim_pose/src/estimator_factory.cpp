@@ -78,7 +78,7 @@ void applyTargetDefaults(PoseConfig* config) {
   // (the fine approach datasets, 16 -> 6 m: 7-10 m port position RMS 8-10 -> 1-1.2 mm), but never its
   // roll (contours_for_boresight: inside 2 m the docking port's inner contours kept ICP-alone frames from
   // converging), at most 500 pairs a frame (speed), from a prediction far off only after a small step
-  // (contour_wait_px), and inside 12 m only (contour_max_depth_m); Hubble as tuned before (all pairs, from
+  // (contour_wait_px), and inside 16 m only (contour_max_depth_m); Hubble as tuned before (all pairs, from
   // the first iteration, at any range, its roll too).
   config->icp.contours_for_boresight = hubble;
   config->icp.max_contour_pairs = hubble ? 0 : defaults.icp.max_contour_pairs;

@@ -71,11 +71,11 @@ struct IcpOptions {
   // edges, and the contours held the pose there (13-16 cm off). 0: from the first iteration. By target: 1.5
   // (the ISS), 0 (Hubble).
   double contour_wait_px = 1.5;
-  // Only where the model's nearest predicted surface is nearer than this (m; 0: everywhere). By target: 12
-  // (the ISS: its weak direction matters inside ~12 m, the docking adapter's rim; beyond, where the crop
-  // alone leaves the port within 2 mm, the contours cost a 30 m benchmark frame 10 % of its instructions), 0
-  // (Hubble).
-  double contour_max_depth_m = 12.0;
+  // Only where the model's nearest predicted surface is nearer than this (m; 0: everywhere). By target: 16
+  // (the ISS: its weak direction is the docking adapter's, inside ~16 m; beyond, where the crop alone leaves
+  // the port within ~2 mm, the contours cost a 30 m benchmark frame 10 % of its instructions; with 12, the
+  // hand-over gtest's frame at 12 m slid 49 mm on the offsets), 0 (Hubble).
+  double contour_max_depth_m = 16.0;
   double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
   // Tracking: the rotation about the boresight is held near the prediction with this standard deviation
   // (deg; a prior in the normal equations): where the scan barely observes it (a near-symmetric docking
@@ -172,7 +172,7 @@ class IcpTracker : public PoseMethod {
     acquiring_ = true;
     acquired_.clear();
     tracked_frames_ = 0;
-    last_tracking_ = false;
+    tracked_.clear();
   }
 
   bool acquiring() const { return acquiring_; }
@@ -217,8 +217,10 @@ class IcpTracker : public PoseMethod {
                    const Eigen::Isometry3d& T_prior);
   // Every stride-th scan point within explained_distance_m of the model surface visible in visible_, at T.
   int explainedPoints(const Eigen::Isometry3d& T, int stride);
-  // The pose at stamp_s extrapolated at constant velocity from the last two acquisition estimates.
-  bool extrapolateAcquired(double stamp_s, Eigen::Isometry3d* T) const;
+  // The pose at stamp_s extrapolated at constant velocity from two (stamp s, pose), the older first; false
+  // without two in time order before stamp_s.
+  static bool extrapolate(const std::vector<std::pair<double, Eigen::Isometry3d>>& poses, double stamp_s,
+                          Eigen::Isometry3d* T);
   double coverage() const;
   void alignRange(Eigen::Isometry3d* T);
   // Makes current a visibility prediction at T: one of the two kept (the last two made) when it was made at
@@ -300,9 +302,8 @@ class IcpTracker : public PoseMethod {
   std::array<VisibilitySlot, 2> slots_;
   int current_ = 0;
   bool acquiring_ = true;
-  // The last frame's estimate, and whether it was a TRACKING one (IcpOptions::contour_wait_px).
-  Eigen::Isometry3d T_last_ = Eigen::Isometry3d::Identity();
-  bool last_tracking_ = false;
+  // (stamp s, pose) of the last TRACKING estimates in a row, at most two (IcpOptions::contour_wait_px).
+  std::vector<std::pair<double, Eigen::Isometry3d>> tracked_;
   int tracked_frames_ = 0;  // tracking frames in a row before this one (IcpOptions::boresight_prior_frames)
   std::vector<std::pair<double, Eigen::Isometry3d>>
       acquired_;  // (stamp s, pose) of the last acquisition frames
