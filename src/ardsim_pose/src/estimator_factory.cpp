@@ -75,11 +75,11 @@ void applyTargetDefaults(PoseConfig* config) {
   // every run; without the arrays' edges, session 22: 0.15-0.21 cm, 0.016-0.033 deg). The ISS's weak
   // direction, across the boresight inside ~16 m once the visibility crop leaves out the walls its lidar
   // sees too obliquely to return (VisibilityOptions::max_incidence_deg), takes them too since session 33
-  // (the fine approach datasets, 16 -> 6 m: 7-10 m port position RMS 8-10 -> 1-1.2 mm), but never its
-  // roll (contours_for_boresight: inside 2 m the docking port's inner contours kept ICP-alone frames from
-  // converging), at most 500 pairs a frame (speed), from a prediction far off only after a small step
-  // (contour_wait_px), and inside 16 m only (contour_max_depth_m); Hubble as tuned before (all pairs, from
-  // the first iteration, at any range, its roll too).
+  // (the fine approach datasets, 16 -> 6 m, six render seeds: 7-10 m port position RMS 6.2-10.4 -> 1.4-1.8
+  // mm), but never its roll (contours_for_boresight: inside 2 m the docking port's inner contours kept
+  // ICP-alone frames from converging), at most 500 pairs a frame (speed), from a prediction far off only
+  // after a small step (contour_wait_px), and inside 16 m only (contour_max_depth_m); Hubble as tuned before
+  // (all pairs, from the first iteration, at any range, its roll too).
   config->icp.contours_for_boresight = hubble;
   config->icp.max_contour_pairs = hubble ? 0 : defaults.icp.max_contour_pairs;
   config->icp.contour_wait_px = hubble ? 0.0 : defaults.icp.contour_wait_px;
