@@ -439,30 +439,45 @@ TEST(IssHandOver, CompositeTakesIcpRollWhereTheRingsIsWeak) {
   EXPECT_LT(composite_deg, 0.75 * ring_deg) << ring_deg;  // measured 0.038
 }
 
+// The ISS's defaults with ICP alone.
+PoseConfig issIcpAlone() {
+  PoseConfig config;
+  config.method = "icp";
+  applyTargetDefaults(&config);
+  return config;
+}
+
+// The ISS along its docking axis from from_port_m (port to port: the lidar is 1 m behind the chaser's port),
+// 2 cm a 0.1 s frame for frames + 1 frames, noise on (simulator seed 5), from the truth at the first: each
+// frame's error to visit; no frame LOST.
+template <typename Visit>
+void issIcpAloneApproach(const PoseConfig& config, double from_port_m, int frames, Visit visit) {
+  ardsim_lidar::NoiseOptions noise;
+  noise.enabled = true;
+  AlongTheDockingAxis iss(config, ardsim_description::buildIss(), 5, 0.1, noise);
+  for (int k = 0; k <= frames; ++k) {
+    PoseErrorValue e;
+    const EstimatorOutput out = iss.frame(k, from_port_m - 0.02 * k, &e);
+    EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
+    visit(e);
+  }
+}
+
 // ICP alone closing on the ISS's docking adapter from 13 to 7 m (lidar to port), noise on, 2 cm a 0.1 s
 // frame, from the truth at the first. Inside ~8 m the roll about the boresight rests on a few asymmetric
 // features and is held near its prediction; with the prior tightened once tracked for
 // icp/boresight_prior_frames frames, the held roll averages over the frames instead of following each frame's
 // fit. Returns the attitude RMS at 7-8 m.
 double issAdapterAttitudeRmsDeg(int boresight_prior_frames) {
-  PoseConfig config;
-  config.method = "icp";
-  applyTargetDefaults(&config);
+  PoseConfig config = issIcpAlone();
   config.icp.boresight_prior_frames = boresight_prior_frames;
-  ardsim_lidar::NoiseOptions noise;
-  noise.enabled = true;
-  AlongTheDockingAxis iss(config, ardsim_description::buildIss(), 5, 0.1, noise);
   double sum_sq = 0.0;
   int count = 0;
-  for (int k = 0; k <= 300; ++k) {
-    const double port_m = 12.0 - 0.02 * k;  // port to port: the lidar is 1 m behind the chaser's port
-    PoseErrorValue e;
-    const EstimatorOutput out = iss.frame(k, port_m, &e);
-    EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    if (e.range_m >= 8.0) continue;
+  issIcpAloneApproach(config, 12.0, 300, [&](const PoseErrorValue& e) {
+    if (e.range_m >= 8.0) return;
     sum_sq += std::pow(e.attitude_error_angle_rad * 180.0 / M_PI, 2);
     ++count;
-  }
+  });
   EXPECT_GE(count, 40);
   return std::sqrt(sum_sq / std::max(1, count));
 }
@@ -481,26 +496,17 @@ TEST(IssCloseApproach, TightenedBoresightPriorMeetsTheAttitudeGoal) {
 // adapter's face seen end-on measures the port across the boresight only at its rims. Returns the port
 // position error's mean across the boresight (lidar x) and its RMS (all axes), m, at 7-10 m.
 std::pair<double, double> issAdapterLateralErrorM(double max_incidence_deg, double contour_sigma_px) {
-  PoseConfig config;
-  config.method = "icp";
-  applyTargetDefaults(&config);
+  PoseConfig config = issIcpAlone();
   config.visibility.max_incidence_deg = max_incidence_deg;
   config.icp.contour_sigma_px = contour_sigma_px;
-  ardsim_lidar::NoiseOptions noise;
-  noise.enabled = true;
-  AlongTheDockingAxis iss(config, ardsim_description::buildIss(), 5, 0.1, noise);
   double sum_x = 0.0, sum_sq = 0.0;
   int count = 0;
-  for (int k = 0; k <= 250; ++k) {
-    const double port_m = 10.0 - 0.02 * k;  // port to port: the lidar is 1 m behind the chaser's port
-    PoseErrorValue e;
-    const EstimatorOutput out = iss.frame(k, port_m, &e);
-    EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    if (e.range_m >= 10.0 || e.range_m < 7.0) continue;
+  issIcpAloneApproach(config, 10.0, 250, [&](const PoseErrorValue& e) {
+    if (e.range_m >= 10.0 || e.range_m < 7.0) return;
     sum_x += e.port_position_error_m.x();
     sum_sq += e.port_position_error_m.squaredNorm();
     ++count;
-  }
+  });
   EXPECT_GE(count, 140);
   return {sum_x / std::max(1, count), std::sqrt(sum_sq / std::max(1, count))};
 }
