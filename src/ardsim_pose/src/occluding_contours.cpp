@@ -69,10 +69,7 @@ void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<i
       const int ru = reach * std::abs(s[0]) + std::abs(s[1]), rv = reach * std::abs(s[1]) + std::abs(s[0]);
       if (u - ru < 0 || u + ru >= w || v - rv < 0 || v + rv >= h) continue;
       // No return, or one far behind (no return is +inf): across an edge of the surface at z.
-      if (depth_[(v + s[1]) * w + u + s[0]] > z + depth_jump_m_) {
-        pairs_.push_back({u, v, s[0], s[1], z});
-        (s[1] != 0 ? column_has_pair_[u] : row_has_pair_[v]) = 1;
-      }
+      if (depth_[(v + s[1]) * w + u + s[0]] > z + depth_jump_m_) pairs_.push_back({u, v, s[0], s[1], z});
     }
   }
   // Runs: pairs of one direction side by side along the edge (across rows: along the row).
@@ -103,10 +100,8 @@ void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<i
     for (std::size_t k = 0; k < static_cast<std::size_t>(max_pairs_); ++k)
       kept_.push_back(pairs_[k * count / max_pairs_]);
     pairs_.swap(kept_);
-    column_has_pair_.assign(w, 0);
-    row_has_pair_.assign(h, 0);
-    for (const Pair& p : pairs_) (p.dv != 0 ? column_has_pair_[p.u] : row_has_pair_[p.v]) = 1;
   }
+  for (const Pair& p : pairs_) (p.dv != 0 ? column_has_pair_[p.u] : row_has_pair_[p.v]) = 1;
 }
 
 void OccludingContours::selectCandidates(const ReferenceModel& model,

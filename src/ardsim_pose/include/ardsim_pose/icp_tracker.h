@@ -65,11 +65,11 @@ struct IcpOptions {
   // iteration. By target: 500 (the ISS: its docking adapter at 6-16 m gives ~5000, and 500 place its rims
   // within ~1 mm RMS), 0 (Hubble).
   int max_contour_pairs = 500;
-  // A tracking frame whose prediction lies beyond the contours' window (3 px) of the last TRACKING estimate,
-  // and an acquisition's alignment, take the contours only after an iteration whose step moved the model
-  // less than this many pixels: from the benchmark's predictions, 0.2 m off at 10 m, the window holds other
-  // edges, and the contours held the pose there (13-16 cm off). 0: from the first iteration. By target: 1.5
-  // (the ISS), 0 (Hubble).
+  // A tracking frame whose prediction lies beyond the contours' window (3 px) of where the last two TRACKING
+  // estimates carry on to, and an acquisition's alignment, take the contours only after an iteration whose
+  // step moved the model less than this many pixels: from the benchmark's predictions, 0.2 m off at 10 m, the
+  // window holds other edges, and the contours held the pose there (13-16 cm off). 0: from the first
+  // iteration. By target: 1.5 (the ISS), 0 (Hubble).
   double contour_wait_px = 1.5;
   // Only where the model's nearest predicted surface is nearer than this (m; 0: everywhere). By target: 16
   // (the ISS: its weak direction is the docking adapter's, inside ~16 m; beyond, where the crop alone leaves
