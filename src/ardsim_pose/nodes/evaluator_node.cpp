@@ -34,7 +34,17 @@ class PoseEvaluator {
     constexpr std::uint32_t kQueue = 1000;
     estimate_subscriber_ = nh.subscribe("pose/estimate", kQueue, &PoseEvaluator::onEstimate, this);
     target_subscriber_ = nh.subscribe("truth/target/odom", kQueue, &PoseEvaluator::onTarget, this);
-    chaser_subscriber_ = nh.subscribe("truth/chaser/odom", kQueue, &PoseEvaluator::onChaser, this);
+    // truth/chaser/odom only once connected to the other two's publishers: the dynamics starts once this node
+    // too listens to it (docking.launch's wait_for_subscribers), and connected later, under load, this node
+    // missed the first 275 frames' estimates or truth (a CI run of the default scenario: its first
+    // /pose/error at 27.5 s). Polled in wall time: the clock stands still until the dynamics starts.
+    connect_timer_ =
+        nh.createWallTimer(ros::WallDuration(0.01), [this, nh](const ros::WallTimerEvent&) mutable {
+          if (estimate_subscriber_.getNumPublishers() == 0 || target_subscriber_.getNumPublishers() == 0)
+            return;
+          chaser_subscriber_ = nh.subscribe("truth/chaser/odom", kQueue, &PoseEvaluator::onChaser, this);
+          connect_timer_.stop();
+        });
   }
 
  private:
@@ -89,6 +99,7 @@ class PoseEvaluator {
   std::map<ros::Time, ardsim_msgs::PoseEstimateConstPtr> estimates_;
   ros::Publisher error_publisher_;
   ros::Subscriber estimate_subscriber_, target_subscriber_, chaser_subscriber_;
+  ros::WallTimer connect_timer_;
 };
 
 }  // namespace ardsim_pose
