@@ -930,6 +930,21 @@ bool IcpTracker::extrapolate(const std::vector<std::pair<double, Eigen::Isometry
 }
 
 PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted) {
+  bool aligned = false;
+  const PoseResult tracked = estimateFrame(cloud, T_predicted, &aligned);
+  if (tracked.acquiring || tracked.status != EstimateStatus::kLost || !aligned) return tracked;
+  // A tracking frame that loses the target (a prediction beyond the tracking gate: a frame dropped, a
+  // faster motion than the last two estimates said) searches for it again at once, as the next frame would:
+  // the dataset at 1 m a frame lost its second frame (the prediction, with no velocity yet, 1 m off) where
+  // the acquisition search finds it (DEGRADED while acquiring, as any acquisition frame).
+  PoseResult searched = estimateFrame(cloud, T_predicted, &aligned);
+  searched.reason = "tracking lost (" + tracked.reason + "), searched again: " + searched.reason;
+  return searched;
+}
+
+PoseResult IcpTracker::estimateFrame(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted,
+                                     bool* aligned) {
+  *aligned = false;
   PoseResult result;
   result.method = EstimateMethod::kIcp;
   result.T_lidar_target = T_predicted;
@@ -1012,6 +1027,7 @@ PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isomet
 
   cloud_ = &cloud;
   contours_extracted_ = false;
+  *aligned = true;
   const Alignment a =
       acquiring ? acquire(T_predicted)
                 : align(T_predicted, options_.gate_tracking_m, options_.max_iterations_tracking, true, 1);

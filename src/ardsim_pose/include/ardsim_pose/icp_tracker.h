@@ -165,6 +165,8 @@ class IcpTracker : public PoseMethod {
   // model given above is then the rigid structure alone.
   void trackPanels(std::unique_ptr<PanelTracker> panels) { panels_ = std::move(panels); }
 
+  // A tracking frame that would be LOST after its alignment is searched again at once as an acquisition
+  // frame.
   PoseResult estimate(const OrganizedCloud& cloud,
                       const Eigen::Isometry3d& T_lidar_target_predicted) override;
   // Back to acquisition: the next frame starts from its prediction with the wide gate and more iterations.
@@ -185,6 +187,9 @@ class IcpTracker : public PoseMethod {
   const IcpOptions& options() const { return options_; }
 
  private:
+  // One frame, tracking or acquiring as the tracker stands; *aligned: the frame got as far as an alignment
+  // (not refused for its input: empty, the wrong size, too few returns).
+  PoseResult estimateFrame(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted, bool* aligned);
   // ICP from T_start; the gate starts at gate_m. Fills correspondences_ and the visibility of the result.
   struct Alignment {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
