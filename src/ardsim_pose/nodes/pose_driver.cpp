@@ -84,6 +84,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/boresight_prior_deg", &i.boresight_prior_deg);
   read(nh, "icp/boresight_prior_max_information", &i.boresight_prior_max_information);
+  read(nh, "icp/boresight_prior_when_observed", &i.boresight_prior_when_observed);
   read(nh, "icp/boresight_prior_frames", &i.boresight_prior_frames);
   read(nh, "icp/boresight_prior_min_deg", &i.boresight_prior_min_deg);
   read(nh, "icp/acquisition_boresight_gate_deg", &i.acquisition_boresight_gate_deg);

@@ -721,13 +721,25 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       Eigen::Matrix<double, 6, 6> H_solve = H;
       Eigen::Matrix<double, 6, 1> g_solve = g;
       const Eigen::Isometry3d* T_prior = tracking ? &T_start : T_boresight_prior;
-      a.boresight_held = T_prior != nullptr && options_.boresight_prior_deg > 0.0 &&
-                         boresight_information < options_.boresight_prior_max_information;
-      if (a.boresight_held) {
-        const double prior_rad =
-            tracking ? trackingBoresightPriorRad() : 2.0 * options_.boresight_prior_deg * M_PI / 180.0;
+      const bool prior = T_prior != nullptr && options_.boresight_prior_deg > 0.0;
+      a.boresight_held = prior && boresight_information < options_.boresight_prior_max_information;
+      const double prior_rad =
+          tracking ? trackingBoresightPriorRad() : 2.0 * options_.boresight_prior_deg * M_PI / 180.0;
+      const Eigen::AngleAxisd turn(prior ? Eigen::Matrix3d(T.linear() * T_prior->linear().transpose())
+                                         : Eigen::Matrix3d::Identity());
+      bool fused = a.boresight_held;
+      if (!fused && prior && tracking && options_.boresight_prior_when_observed) {
+        // Observed, and tracking: the prior fused with the scan's (IcpOptions::boresight_prior_when_observed)
+        // where the scan's own rotation (a step without the prior) lies within 3 sigma of the prediction's,
+        // the two sigmas combined: a prediction that is off (a change of rate, the benchmark's guesses turned
+        // 0.5 deg) is not followed.
+        const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt = H.ldlt();
+        const double own_rad = turn.angle() * turn.axis().z() + ldlt.solve(g)(5);
+        const double own_variance = sigma * sigma * ldlt.solve(Eigen::Matrix<double, 6, 1>::Unit(5))(5);
+        fused = own_rad * own_rad < 9.0 * (own_variance + prior_rad * prior_rad);
+      }
+      if (fused) {
         const double information = sigma * sigma / (prior_rad * prior_rad);
-        const Eigen::AngleAxisd turn(T.linear() * T_prior->linear().transpose());
         H_solve(5, 5) += information;
         g_solve(5) -= information * turn.angle() * turn.axis().z();
       }

@@ -528,19 +528,59 @@ void issIcpAloneApproach(const PoseConfig& config, double from_port_m, int frame
 // frame, from the truth at the first. Inside ~8 m the roll about the boresight rests on a few asymmetric
 // features and is held near its prediction; with the prior tightened once tracked for
 // icp/boresight_prior_frames frames, the held roll averages over the frames instead of following each frame's
-// fit. Returns the attitude RMS at 7-8 m.
-double issAdapterAttitudeRmsDeg(int boresight_prior_frames) {
+// fit. Returns the attitude RMS at from_m to below_m (7-8 m by default).
+double issAdapterAttitudeRmsDeg(int boresight_prior_frames, bool prior_when_observed = true,
+                                double from_m = 7.0, double below_m = 8.0) {
   PoseConfig config = issIcpAlone();
   config.icp.boresight_prior_frames = boresight_prior_frames;
+  config.icp.boresight_prior_when_observed = prior_when_observed;
   double sum_sq = 0.0;
   int count = 0;
   issIcpAloneApproach(config, 12.0, 300, [&](const PoseErrorValue& e) {
-    if (e.range_m >= 8.0) return;
+    if (e.range_m >= below_m || e.range_m < from_m) return;
     sum_sq += std::pow(e.attitude_error_angle_rad * 180.0 / M_PI, 2);
     ++count;
   });
   EXPECT_GE(count, 40);
   return std::sqrt(sum_sq / std::max(1, count));
+}
+
+// With the prior as tight as after a long track (boresight_prior_frames 1: 0.02 deg by the 100th frame),
+// fused where the scan observes the roll too (icp/boresight_prior_when_observed), the docking adapter's roll
+// at 8-10 m averages over frames instead of following each frame's fit (measured 0.0166 against 0.0263 deg;
+// the closed loop with ICP alone, five lidar seeds: 8-9 m 0.025-0.026 -> 0.013-0.016 deg).
+TEST(IssCloseApproach, BoresightPriorFusedWhereTheRollIsObserved) {
+  const double fused_deg = issAdapterAttitudeRmsDeg(1, true, 8.0, 10.0);
+  const double scan_deg = issAdapterAttitudeRmsDeg(1, false, 8.0, 10.0);
+  EXPECT_LT(fused_deg, 0.02);
+  EXPECT_LT(fused_deg, 0.8 * scan_deg) << scan_deg;
+  std::printf("8-10 m attitude RMS: prior fused where observed %.4f deg, the scan's alone %.4f deg\n",
+              fused_deg, scan_deg);
+}
+
+// ... but not where the scan's own roll disagrees with the prediction's beyond 3 sigma (both combined): a
+// prediction turned 0.5 deg about the boresight (a change of rate; the benchmark's guesses) is not followed.
+TEST(IssTracking, BoresightPriorDoesNotFollowAPredictionOffInRoll) {
+  PoseConfig config;
+  config.icp.boresight_prior_deg = 0.01;  // as tight as after a long track
+  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 7);
+  simulator.setTarget(ardsim_description::buildIss());
+  IcpTracker tracker(buildReferenceModel(TargetKind::kIss, config.model),
+                     ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
+  ardsim_lidar::LidarFrame frame;
+  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kIss);
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kIss, 29.0 - 0.02 * k);
+    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
+    Eigen::Isometry3d predicted = truth;
+    if (k == 2)
+      predicted.linear() = Eigen::AngleAxisd(0.5 * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * truth.linear();
+    const PoseResult result = tracker.estimate(fromLidarFrame(frame, simulator.rays(), 0.1 * k), predicted);
+    ASSERT_EQ(result.status, EstimateStatus::kTracking) << "frame " << k << ": " << result.reason;
+    // The third frame within the 30 m goal (measured 0.023 deg; following the prediction: 0.40).
+    const PoseErrorValue e = poseError(result.T_lidar_target, truth, T_target_port);
+    EXPECT_LT(e.attitude_error_angle_rad * 180.0 / M_PI, 0.05) << "frame " << k;
+  }
 }
 
 TEST(IssCloseApproach, TightenedBoresightPriorMeetsTheAttitudeGoal) {
