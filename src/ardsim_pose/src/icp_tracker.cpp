@@ -738,6 +738,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
         const double own_variance = sigma * sigma * ldlt.solve(Eigen::Matrix<double, 6, 1>::Unit(5))(5);
         fused = own_rad * own_rad < 9.0 * (own_variance + prior_rad * prior_rad);
       }
+      a.boresight_prior_rad = fused ? prior_rad : 0.0;
       if (fused) {
         const double information = sigma * sigma / (prior_rad * prior_rad);
         H_solve(5, 5) += information;
@@ -746,6 +747,7 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
       delta = H_solve.ldlt().solve(g_solve);
     } else {
       a.boresight_held = false;
+      a.boresight_prior_rad = 0.0;
       delta.head<5>() = H.topLeftCorner<5, 5>().ldlt().solve(g.head<5>());
     }
     // The weak directions' part of the step (from the tangential offsets), judged on its own below.
@@ -1061,13 +1063,20 @@ PoseResult IcpTracker::estimateFrame(const OrganizedCloud& cloud, const Eigen::I
   result.fit_rms_m = std::sqrt(inlier_sq_sum / std::max(1, inliers));
   result.inlier_fraction = silhouetteInlierFraction(a.limit_m);
 
-  // Covariance of (v, w) about the centre from the last normal equations, mapped to the target origin's
-  // position and the rotation: delta_origin = v + w x (origin - centre).
+  // Covariance of (v, w) about the centre from the last normal equations, the boresight rotation's prior
+  // included where the last iteration took it (its sigma then bounds that rotation's: a roll averaged over
+  // frames by the prior is known better than one frame's planes say, and the composite pose takes ICP's roll
+  // by it, EstimatorOptions::composite_icp_roll_max_sigma_deg), mapped to the target origin's position and
+  // the rotation: delta_origin = v + w x (origin - centre).
   const double dof = std::max(1.0, weight_sum - 6.0);
   const double variance = std::max(weighted_sq_sum / dof, options_.min_sigma_m * options_.min_sigma_m);
   Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Identity();
   A.block<3, 3>(0, 3) = -skew(T.translation() - centre);
-  const Eigen::Matrix<double, 6, 6> H_inverse = H.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  Eigen::Matrix<double, 6, 6> H_posterior = H;
+  if (a.boresight_prior_rad > 0.0)
+    H_posterior(5, 5) += variance / (a.boresight_prior_rad * a.boresight_prior_rad);
+  const Eigen::Matrix<double, 6, 6> H_inverse =
+      H_posterior.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
   result.covariance = A * (variance * H_inverse) * A.transpose();
 
   // Condition of the lever-scaled normal equations.

@@ -211,7 +211,8 @@ class IcpTracker : public PoseMethod {
     double limit_m = 0.0;  // the Tukey limit of the last iteration
     Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    bool boresight_held = false;  // the last iteration held the boresight rotation near a prior
+    bool boresight_held = false;       // the last iteration held the boresight rotation near a prior
+    double boresight_prior_rad = 0.0;  // the last iteration's prior on that rotation (held or fused; 0: none)
   };
   // Uses every stride-th scan point. tracking: from a prediction (T_start): scan points left unmatched are
   // not searched again, and a barely observed boresight rotation is held near T_start (boresight_prior_deg).
