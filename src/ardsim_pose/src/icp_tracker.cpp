@@ -945,19 +945,19 @@ bool IcpTracker::extrapolate(const std::vector<std::pair<double, Eigen::Isometry
 
 PoseResult IcpTracker::estimate(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted) {
   bool aligned = false;
-  const PoseResult tracked = estimateFrame(cloud, T_predicted, &aligned);
+  const PoseResult tracked = processFrame(cloud, T_predicted, &aligned);
   if (tracked.acquiring || tracked.status != EstimateStatus::kLost || !aligned) return tracked;
   // A tracking frame that loses the target (a prediction beyond the tracking gate: a frame dropped, a
   // faster motion than the last two estimates said) searches for it again at once, as the next frame would:
   // the dataset at 1 m a frame lost its second frame (the prediction, with no velocity yet, 1 m off) where
   // the acquisition search finds it (DEGRADED while acquiring, as any acquisition frame).
-  PoseResult searched = estimateFrame(cloud, T_predicted, &aligned);
+  PoseResult searched = processFrame(cloud, T_predicted, &aligned);
   searched.reason = "tracking lost (" + tracked.reason + "), searched again: " + searched.reason;
   return searched;
 }
 
-PoseResult IcpTracker::estimateFrame(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted,
-                                     bool* aligned) {
+PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted,
+                                    bool* aligned) {
   *aligned = false;
   PoseResult result;
   result.method = EstimateMethod::kIcp;

@@ -197,7 +197,7 @@ class IcpTracker : public PoseMethod {
  private:
   // One frame, tracking or acquiring as the tracker stands; *aligned: the frame got as far as an alignment
   // (not refused for its input: empty, the wrong size, too few returns).
-  PoseResult estimateFrame(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted, bool* aligned);
+  PoseResult processFrame(const OrganizedCloud& cloud, const Eigen::Isometry3d& T_predicted, bool* aligned);
   // ICP from T_start; the gate starts at gate_m. Fills correspondences_ and the visibility of the result.
   struct Alignment {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
