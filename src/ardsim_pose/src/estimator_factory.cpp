@@ -106,8 +106,8 @@ void applyTargetDefaults(PoseConfig* config) {
   config->estimator.composite_max_port_range_m = hubble ? 30.0 : 12.5;
   // Since session 34 ICP's covariance takes in its roll prior (held, or fused where observed:
   // IcpOptions::boresight_prior_when_observed), so a roll averaged over a long track passes the ISS's 0.03
-  // (`auto`, five lidar seeds: 7-8 m attitude RMS 0.026-0.029 -> 0.018-0.019 deg, 8-9 m 0.025-0.038 ->
-  // 0.015-0.021), one over a few hundred frames mostly not (the README's dataset at 0.5 m a frame: its 7-10 m
+  // (`auto`, five lidar seeds: 7-8 m attitude RMS 0.026-0.029 -> 0.018-0.022 deg, 8-9 m 0.025-0.038 ->
+  // 0.015-0.022), one over a few hundred frames mostly not (the README's dataset at 0.5 m a frame: its 7-10 m
   // stays the ring's; with 1 deg there, 0.016 -> 0.024 deg).
   config->estimator.composite_icp_roll_max_sigma_deg = hubble ? 1.0 : 0.03;
   // Hubble's tilt at 30-50 m is a frame's to ~0.02-0.05 deg: its rotation rate learns from several

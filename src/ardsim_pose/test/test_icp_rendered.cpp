@@ -578,7 +578,7 @@ double issAdapterAttitudeRmsDeg(int boresight_prior_frames, bool prior_when_obse
 // With the prior as tight as after a long track (boresight_prior_frames 1: 0.02 deg by the 100th frame),
 // fused where the scan observes the roll too (icp/boresight_prior_when_observed), the docking adapter's roll
 // at 8-10 m averages over frames instead of following each frame's fit (measured 0.0166 against 0.0263 deg;
-// the closed loop with ICP alone, five lidar seeds: 8-9 m 0.025-0.026 -> 0.013-0.016 deg).
+// the closed loop with ICP alone, five lidar seeds: 8-9 m 0.025-0.026 -> 0.016-0.019 deg).
 TEST(IssCloseApproach, BoresightPriorFusedWhereTheRollIsObserved) {
   const double fused_deg = issAdapterAttitudeRmsDeg(1, true, 8.0, 10.0);
   const double scan_deg = issAdapterAttitudeRmsDeg(1, false, 8.0, 10.0);

@@ -87,12 +87,12 @@ struct IcpOptions {
   // one frame and kept it for a second in hubble_hold, while its covariance said 0.05 deg).
   double boresight_prior_max_information = 0.01;
   // Tracking, that prior also where the scan observes the rotation (above that limit), fused with the scan's
-  // where the two agree (the scan's own within 3 sigma of the prediction's, both sigmas combined: a
-  // prediction off in roll is not followed): there the rotation is still measured (not held: the prediction
-  // learns its rate from it), but averaged over frames as the prior tightens. The ISS's docking adapter at
-  // 7-10 m gives a frame's roll to only ~0.03 deg, above the limit (ICP alone, closed loop, five lidar seeds:
-  // 7-8 m attitude RMS 0.025-0.043 -> 0.015-0.021 deg; 3x worst/RMS rule at 7-12 m over in 10 of 40 checks ->
-  // 0). false: the scan's alone there.
+  // in the alignment's fine stage where the two agree (the scan's own within 3 sigma of the prediction's,
+  // both sigmas combined: a prediction off in roll is not followed): there the rotation is still measured
+  // (not held: the prediction learns its rate from it), but averaged over frames as the prior tightens. The
+  // ISS's docking adapter at 7-10 m gives a frame's roll to only ~0.03 deg, above the limit (ICP alone,
+  // closed loop, five lidar seeds: 8-9 m attitude RMS 0.025-0.026 -> 0.016-0.019 deg; 3x worst/RMS rule at
+  // 7-12 m over in 10 of 40 checks -> 1). false: the scan's alone there.
   bool boresight_prior_when_observed = true;
   // ... and once tracking for more than boresight_prior_frames frames in a row (0: never), that prior
   // tightens as 1 / sqrt(the frames tracked), down to boresight_prior_min_deg: the held rotation is an
