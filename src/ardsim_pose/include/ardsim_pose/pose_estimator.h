@@ -68,9 +68,9 @@ struct EstimatorOptions {
   double composite_max_port_range_m = 0.0;
   // ... and the rotation about the line of sight from ICP too where its TRACKING estimate's standard
   // deviation of it (its covariance: the scan's information, and since session 34 the roll prior where ICP
-  // took it) is below this, deg: Hubble with its arrays in ICP's model and in view, ~0.004 (on the masts alone
-  // 0.04-0.09). The ring method, blind to it, holds the roll it was handed at 20 m: in hubble_hold_arrays30
-  // 10-20 m 0.054 -> 0.037 deg RMS. 0: never.
+  // took it) is below this, deg: Hubble with its arrays in ICP's model and in view, ~0.004 (on the masts
+  // alone 0.04-0.09). The ring method, blind to it, holds the roll it was handed at 20 m: in
+  // hubble_hold_arrays30 10-20 m 0.054 -> 0.037 deg RMS. 0: never.
   double composite_icp_roll_max_sigma_deg = 0.01;
 };
 void validate(const EstimatorOptions& options);
