@@ -232,32 +232,41 @@ TEST_F(LostFrames, AnotherObjectIsLost) {
 // yet: the second frame of a dataset at 10 m/s) is searched for again in the same frame: DEGRADED while
 // acquiring, within the 100 m goals, where it was LOST before (session 34). A frame of garbage or of another
 // object while tracking still ends LOST after that search, never a pose.
+// An ISS tracker of config on noisy frames rendered by one simulator (seed 7), frame k stamped k x 0.1 s.
+struct RenderedIssTracker {
+  explicit RenderedIssTracker(const PoseConfig& config_in,
+                              std::shared_ptr<const ReferenceModel> model = nullptr)
+      : config(config_in),
+        tracker(model ? model : buildReferenceModel(TargetKind::kIss, config.model),
+                ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility) {
+    simulator.setTarget(ardsim_description::buildIss());
+  }
+  OrganizedCloud render(const Eigen::Isometry3d& truth, int k) {
+    simulator.simulate(truth, static_cast<std::uint64_t>(k), &frame);
+    return fromLidarFrame(frame, simulator.rays(), 0.1 * k);
+  }
+  PoseConfig config;  // first: the members below are made from it
+  ardsim_lidar::LidarSimulator simulator{config.sensor, ardsim_lidar::NoiseOptions{}, 7};
+  IcpTracker tracker;
+  ardsim_lidar::LidarFrame frame;
+};
+
 class TrackingFallsBack : public LostFrames {
  protected:
-  // An ISS tracker brought to TRACKING on a noisy frame at port distance 99 m (from the truth), and frames
-  // rendered by the same simulator.
+  // An ISS tracker brought to TRACKING on a noisy frame at port distance 99 m (from the truth).
   void SetUp() override {
-    simulator_.setTarget(ardsim_description::buildIss());
-    first_truth_ = dockingAxisPose(TargetKind::kIss, 99.0);
-    const PoseResult first = tracker_.estimate(render(first_truth_, 0), first_truth_);
+    const Eigen::Isometry3d first_truth = dockingAxisPose(TargetKind::kIss, 99.0);
+    const PoseResult first = iss_.tracker.estimate(iss_.render(first_truth, 0), first_truth);
     ASSERT_EQ(first.status, EstimateStatus::kTracking) << first.reason;
     first_estimate_ = first.T_lidar_target;
   }
-  OrganizedCloud render(const Eigen::Isometry3d& truth, int k) {
-    ardsim_lidar::LidarFrame frame;
-    simulator_.simulate(truth, static_cast<std::uint64_t>(k), &frame);
-    return fromLidarFrame(frame, simulator_.rays(), 0.1 * k);
-  }
-  PoseConfig config_;
-  ardsim_lidar::LidarSimulator simulator_{config_.sensor, ardsim_lidar::NoiseOptions{}, 7};
-  IcpTracker tracker_{iss_model_, ardsim_lidar::intrinsicsFor(config_.sensor), config_.icp,
-                      config_.visibility};
-  Eigen::Isometry3d first_truth_, first_estimate_;
+  RenderedIssTracker iss_{PoseConfig{}, iss_model_};
+  Eigen::Isometry3d first_estimate_;
 };
 
 TEST_F(TrackingFallsBack, PredictionBeyondTheGateIsSearchedForInTheFrame) {
   const Eigen::Isometry3d truth = dockingAxisPose(TargetKind::kIss, 98.0);
-  const PoseResult result = tracker_.estimate(render(truth, 1), first_estimate_);
+  const PoseResult result = iss_.tracker.estimate(iss_.render(truth, 1), first_estimate_);
   EXPECT_EQ(result.status, EstimateStatus::kDegraded) << result.reason;
   EXPECT_TRUE(result.acquiring);
   EXPECT_NE(result.reason.find("tracking lost (too few correspondences"), std::string::npos) << result.reason;
@@ -268,7 +277,7 @@ TEST_F(TrackingFallsBack, PredictionBeyondTheGateIsSearchedForInTheFrame) {
 }
 
 TEST_F(TrackingFallsBack, GarbageWhileTrackingIsLost) {
-  ardsim_lidar::PixelRays rays(ardsim_lidar::intrinsicsFor(config_.sensor));
+  ardsim_lidar::PixelRays rays(ardsim_lidar::intrinsicsFor(iss_.config.sensor));
   OrganizedCloud cloud = nanCloud();
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<float> range(90.0f, 130.0f);  // around the target: the gate finds points
@@ -276,15 +285,15 @@ TEST_F(TrackingFallsBack, GarbageWhileTrackingIsLost) {
   for (int i = 0; i < rays.size(); ++i)
     if (hit(rng)) cloud.points[i] = range(rng) * rays.ray(i);
   cloud.stamp_s = 0.1;
-  const PoseResult result = tracker_.estimate(cloud, first_estimate_);
+  const PoseResult result = iss_.tracker.estimate(cloud, first_estimate_);
   EXPECT_EQ(result.status, EstimateStatus::kLost) << result.reason;
   EXPECT_NE(result.reason.find("searched again"), std::string::npos) << result.reason;
 }
 
 TEST_F(TrackingFallsBack, AnotherObjectWhileTrackingIsLost) {
-  simulator_.setTarget(ardsim_description::buildHubble());
+  iss_.simulator.setTarget(ardsim_description::buildHubble());
   const PoseResult result =
-      tracker_.estimate(render(dockingAxisPose(TargetKind::kHubble, 99.0), 1), first_estimate_);
+      iss_.tracker.estimate(iss_.render(dockingAxisPose(TargetKind::kHubble, 99.0), 1), first_estimate_);
   EXPECT_EQ(result.status, EstimateStatus::kLost) << result.reason;
   EXPECT_NE(result.reason.find("searched again"), std::string::npos) << result.reason;
 }
@@ -292,9 +301,7 @@ TEST_F(TrackingFallsBack, AnotherObjectWhileTrackingIsLost) {
 // An ISS tracker with the roll prior as tight as after a long track (0.01 deg), on noisy frames closing 2 cm
 // a 0.1 s frame from port distance 29 m.
 struct TightRollPriorAt29m {
-  explicit TightRollPriorAt29m(bool prior_when_observed) : config(tightRollPrior(prior_when_observed)) {
-    simulator.setTarget(ardsim_description::buildIss());
-  }
+  explicit TightRollPriorAt29m(bool prior_when_observed) : iss(tightRollPrior(prior_when_observed)) {}
   static PoseConfig tightRollPrior(bool prior_when_observed) {
     PoseConfig config;
     config.icp.boresight_prior_deg = 0.01;
@@ -303,14 +310,9 @@ struct TightRollPriorAt29m {
   }
   Eigen::Isometry3d truth(int k) const { return dockingAxisPose(TargetKind::kIss, 29.0 - 0.02 * k); }
   PoseResult track(int k, const Eigen::Isometry3d& predicted) {
-    simulator.simulate(truth(k), static_cast<std::uint64_t>(k), &frame);
-    return tracker.estimate(fromLidarFrame(frame, simulator.rays(), 0.1 * k), predicted);
+    return iss.tracker.estimate(iss.render(truth(k), k), predicted);
   }
-  PoseConfig config;  // first: the members below are made from it
-  ardsim_lidar::LidarSimulator simulator{config.sensor, ardsim_lidar::NoiseOptions{}, 7};
-  IcpTracker tracker{buildReferenceModel(TargetKind::kIss, config.model),
-                     ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility};
-  ardsim_lidar::LidarFrame frame;
+  RenderedIssTracker iss;
 };
 
 // ICP's covariance takes in the roll prior where the last iteration took it: a roll averaged over frames is
