@@ -39,6 +39,10 @@ struct DynamicsNodeOptions {
   int wait_for_subscribers = 0;     // before the first step, wait (up to startup_timeout_s) for this many
                                     // subscribers of truth/chaser/odom
   double duration_s = 0.0;          // run length; 0 = the scenario's simulation.duration_s
+  // > 0: publish step k only once the recorder's record/progress has reached step k - recorder_lag_steps (its
+  // publishers' queues then never overflow); a recorder silent for recorder_timeout_s is no longer waited for.
+  int recorder_lag_steps = 0;
+  double recorder_timeout_s = 10.0;
   // false: after the last step keep the final state latched until shut down, so that slower subscribers drain
   // their queues (a free run outpaces them).
   bool exit_at_end = true;
@@ -63,12 +67,16 @@ DynamicsNodeOptions loadOptions(const ros::NodeHandle& pnh) {
   pnh.param("free_run", o.free_run, o.free_run);
   pnh.param("wait_for_subscribers", o.wait_for_subscribers, o.wait_for_subscribers);
   pnh.param("duration_s", o.duration_s, o.duration_s);
+  pnh.param("recorder_lag_steps", o.recorder_lag_steps, o.recorder_lag_steps);
+  pnh.param("recorder_timeout_s", o.recorder_timeout_s, o.recorder_timeout_s);
   pnh.param("exit_at_end", o.exit_at_end, o.exit_at_end);
   requireRange("real_time_factor", o.real_time_factor, 0.0, 1e6);
   requireRange("command_timeout_s", o.command_timeout_s, 1e-3, 3600.0);
   requireRange("startup_timeout_s", o.startup_timeout_s, 1e-3, 3600.0);
   requireRange("wait_for_subscribers", o.wait_for_subscribers, 0, 100);
   requireRange("duration_s", o.duration_s, 0.0, 1e7);
+  requireRange("recorder_lag_steps", o.recorder_lag_steps, 0, 100000);
+  requireRange("recorder_timeout_s", o.recorder_timeout_s, 1e-3, 3600.0);
   return o;
 }
 
@@ -77,22 +85,33 @@ class DynamicsNode {
   DynamicsNode(ros::NodeHandle& nh, const DynamicsNodeOptions& options, Simulation& sim)
       : options_(options), sim_(sim) {
     // Latched: a node that connects late (at start-up, or respawned) still gets the current step. In lockstep
-    // at most one step is in flight; a free run publishes as fast as it integrates, so its queues must hold a
-    // whole burst.
-    const std::uint32_t queue = options_.free_run ? 100000 : 100;
+    // at most one step is in flight to the nodes in it, but the recorder is outside it and falls behind by
+    // hundreds of steps while it writes clouds; a free run publishes as fast as it integrates, so its queues
+    // must hold a whole burst.
+    const std::uint32_t queue = options_.free_run ? 100000 : 1000;
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", queue, true);
     target_pub_ = nh.advertise<nav_msgs::Odometry>("truth/target/odom", queue, true);
-    chaser_pub_ = nh.advertise<nav_msgs::Odometry>("truth/chaser/odom", queue, true);
     relative_pub_ = nh.advertise<nav_msgs::Odometry>("truth/relative", queue, true);
     applied_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("dynamics/applied_wrench", queue);
     tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", queue);
     contact_pub_ = nh.advertise<ardsim_msgs::ContactEvent>("dynamics/contact", 1, true);
+    // Last: the first step waits for its subscribers (wait_for_subscribers), and a subscriber of all of these
+    // (the recorder) connects to them in the order they were advertised; advertised third, the recorder's /tf
+    // connection came up after it and a short run's bag lacked the first 5 /tf messages.
+    chaser_pub_ = nh.advertise<nav_msgs::Odometry>("truth/chaser/odom", queue, true);
     if (!options_.free_run) {
       ros::SubscribeOptions so = ros::SubscribeOptions::create<geometry_msgs::WrenchStamped>(
           "guidance/command", 10,
           [this](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onCommand(msg); }, ros::VoidPtr(),
           &command_queue_);
       command_sub_ = nh.subscribe(so);
+    }
+    if (options_.recorder_lag_steps > 0) {
+      ros::SubscribeOptions so = ros::SubscribeOptions::create<rosgraph_msgs::Clock>(
+          "record/progress", 10,
+          [this](const rosgraph_msgs::Clock::ConstPtr& msg) { recorded_until_ = std::max(recorded_until_, msg->clock); },
+          ros::VoidPtr(), &command_queue_);
+      progress_sub_ = nh.subscribe(so);
     }
   }
 
@@ -108,6 +127,7 @@ class DynamicsNode {
     while (ros::ok()) {
       const ros::Time stamp(sim_.time());
       pace(wall_start);
+      waitForRecorder(dt);
       publishStep(stamp);
       ros::getGlobalCallbackQueue()->callAvailable();
       if (sim_.contact()) {
@@ -200,6 +220,24 @@ class DynamicsNode {
     tf_pub_.publish(tf);
   }
 
+  void waitForRecorder(double dt) {
+    if (options_.recorder_lag_steps <= 0 || recorder_gone_) return;
+    const double due_s = sim_.time() - (options_.recorder_lag_steps + 0.5) * dt;
+    if (due_s < 0.0) return;
+    const ros::Time due(due_s);
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.recorder_timeout_s);
+    while (ros::ok() && recorded_until_ < due) {
+      command_queue_.callAvailable(ros::WallDuration(0.002));
+      if (ros::WallTime::now() > deadline) {
+        recorder_gone_ = true;
+        ROS_ERROR("dynamics: the recorder's record/progress is at t = %.3f s, %d steps behind t = %.3f s, after "
+                  "%.1f s wall: no longer waiting for it (the bag may lack messages from here on)",
+                  recorded_until_.toSec(), options_.recorder_lag_steps, sim_.time(), options_.recorder_timeout_s);
+        return;
+      }
+    }
+  }
+
   BodyWrench waitForCommand(const ros::Time& stamp, double timeout_s) {
     expected_stamp_ = stamp;
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
@@ -245,7 +283,9 @@ class DynamicsNode {
   Simulation& sim_;
   ros::Publisher clock_pub_, target_pub_, chaser_pub_, relative_pub_, applied_pub_, tf_pub_, contact_pub_;
   ros::CallbackQueue command_queue_;
-  ros::Subscriber command_sub_;
+  ros::Subscriber command_sub_, progress_sub_;
+  ros::Time recorded_until_;
+  bool recorder_gone_ = false;
   ros::Time expected_stamp_;
   BodyWrench command_;
   bool have_command_ = false;

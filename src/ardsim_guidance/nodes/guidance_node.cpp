@@ -105,9 +105,10 @@ class GuidanceNode {
  public:
   GuidanceNode(ros::NodeHandle& nh, const GuidanceOptions& options, double own_state_timeout_s)
       : guidance_(options), own_state_timeout_s_(own_state_timeout_s) {
-    // Latched: the dynamics gets the command of the current step even if it connects after it was sent.
-    command_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("guidance/command", 100, true);
-    state_pub_ = nh.advertise<ardsim_msgs::GuidanceState>("guidance/state", 100, true);
+    // Latched: the dynamics gets the command of the current step even if it connects after it was sent. 1000
+    // queued per subscriber: the recorder, outside the lockstep, falls behind by hundreds of steps.
+    command_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("guidance/command", 1000, true);
+    state_pub_ = nh.advertise<ardsim_msgs::GuidanceState>("guidance/state", 1000, true);
     odom_sub_ = nh.subscribe("truth/chaser/odom", 100, &GuidanceNode::onOdometry, this);
     estimate_sub_ = nh.subscribe("pose/estimate", 100, &GuidanceNode::onEstimate, this);
     // Deadlock breaker only: an estimate whose own-state message never comes is answered after a wall

@@ -18,7 +18,7 @@ namespace ardsim_lidar {
 
 namespace {
 
-constexpr std::uint32_t kRecorderQueue = 50;  // frames queued per subscriber connection
+constexpr std::uint32_t kRecorderQueue = 100;  // frames queued per subscriber connection
 
 // How many nodes the master lists as subscribers of topic (0 if it cannot be asked).
 int registeredSubscribers(const std::string& topic) {
@@ -164,13 +164,14 @@ LidarDriver::LidarDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
   fault_frame_ = empty_frame_;
   // Latched, like every lockstep output: a subscriber that connects late (the pose estimator still loading
   // its model at start-up, or respawned) still gets the current step's frame, and the lockstep does not
-  // stall. Each subscriber's connection queues up to 50 frames (65 MB of clouds) so that a recorder stalled
-  // by its disk for a few seconds of wall time loses nothing (with 2 it lost 1-2 % of a run's messages).
+  // stall. Each subscriber's connection queues up to 100 frames (130 MB of 256 x 256 clouds, held only while
+  // a subscriber lags): the recorder may lag the lockstep by up to its recorder_lag_steps (20 by default;
+  // with 2 queued it lost 1-2 % of a run's messages).
   points_publisher_ = nh.advertise<sensor_msgs::PointCloud2>("lidar/points", kRecorderQueue, true);
   range_publisher_ = nh.advertise<sensor_msgs::Image>("lidar/range", kRecorderQueue, true);
   camera_info_publisher_ = nh.advertise<sensor_msgs::CameraInfo>("lidar/camera_info", kRecorderQueue, true);
   // The aggregator's conventional, global topic.
-  diagnostics_publisher_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+  diagnostics_publisher_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", kRecorderQueue);
   synchronizer_.registerCallback(&LidarDriver::onTruth, this);
   // Listen to the truth (which lets the dynamics start) only once the frames' subscribers are connected.
   waitForRegisteredSubscribers(points_publisher_, 10.0);
