@@ -3,38 +3,38 @@
 // that a burst loses nothing.
 //
 // Why not rosbag record: its subscriber queues hold 100 messages (hard-coded). The recorder sits outside the
-// lockstep and takes ~190 MB/s of clouds in the default run; it falls behind, the publishers keep its messages
-// (their queues hold 1000), and when it catches up a topic's backlog arrives at once and all but the newest 100
-// are discarded: the default run's bag lacked 13 consecutive /pose/error, /guidance/command and
+// lockstep and takes ~190 MB/s of clouds in the default run; it falls behind, the publishers keep its
+// messages (their queues hold 1000), and when it catches up a topic's backlog arrives at once and all but the
+// newest 100 are discarded: the default run's bag lacked 13 consecutive /pose/error, /guidance/command and
 // /truth/chaser/odom messages at 208 s ("Incoming queue was full for topic /pose/error" in its debug log).
 //
 // It also keeps up with the lockstep rather than lose messages: it publishes record/progress
-// (rosgraph_msgs/Clock, latched), the latest stamp up to which every progress topic has been received, and the
-// dynamics (~recorder_lag_steps) does not run more than so many steps ahead of it. A publisher's queue to the
-// recorder then never overflows, however slow the disk or loaded the machine: rosbag record, outside the
-// lockstep, fell behind by thousands of steps on the dynamics' topics while two runs shared 2 cores, and the
-// publishers discarded what their queues could not hold.
+// (rosgraph_msgs/Clock, latched), the latest stamp up to which every progress topic has been received, and
+// the dynamics (~recorder_lag_steps) does not run more than so many steps ahead of it. A publisher's queue to
+// the recorder then never overflows, however slow the disk or loaded the machine. (Outside the lockstep, this
+// recorder fell 2500 steps behind on the dynamics' topics while two default runs shared 2 cores, and the
+// lidar's queue of 500 frames discarded clouds.)
 //
 // Private parameters:
-//   bag              (string, required) the bag to write; BAG.active while recording, renamed to BAG when closed
-//   topics           (string, required) topics to record, space-separated, subscribed in this order
-//   progress_topics  (string, default "") topics, among `topics`, published once a step with a std_msgs/Header
-//                    stamped with the step's time; record/progress is the oldest of their latest stamps
-//   buffer_mb        (int, 0 .. 65536; default 256, 0 = unlimited) messages held for the writer, in MB; beyond
-//                    it the oldest are dropped (as rosbag record's --buffsize), each drop counted and logged
+//   bag: string, required. The bag to write; BAG.active while recording, renamed to BAG when closed.
+//   topics: string, required. Topics to record, space-separated, subscribed in this order.
+//   progress_topics: string, default "". Topics among `topics` published once a step with a std_msgs/Header
+//     stamped with the step's time; record/progress is the oldest of their latest stamps.
+//   buffer_mb: int, 0 .. 65536, default 256 (0 = unlimited). Messages held for the writer, in MB; beyond it
+//     the oldest are dropped (as rosbag record's --buffsize), each drop counted and logged.
 // Ends on SIGINT (roslaunch's stop): writes what it holds, closes the bag, logs what it recorded and dropped.
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosgraph_msgs/Clock.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <condition_variable>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <algorithm>
 #include <cstring>
 #include <deque>
 #include <map>
@@ -47,7 +47,9 @@ namespace {
 
 // Set by SIGINT / SIGTERM: the node stays up until the bag is closed and its summary logged.
 std::atomic<bool> g_stop{false};
-void requestStop(int) { g_stop = true; }
+void requestStop(int) {
+  g_stop = true;
+}
 
 // Deeper than any backlog a publisher can hand over at once (the graph's publishers queue 1000): a burst is
 // taken whole, and the byte budget (buffer_mb) is the only limit.
@@ -93,11 +95,12 @@ bool headerStamp(const topic_tools::ShapeShifter& message, ros::Time* stamp) {
 
 class RunRecorder {
  public:
-  RunRecorder(const std::string& bag_path, std::size_t buffer_bytes, const std::vector<std::string>& progress_topics,
-              ros::NodeHandle& nh)
+  RunRecorder(const std::string& bag_path, std::size_t buffer_bytes,
+              const std::vector<std::string>& progress_topics, ros::NodeHandle& nh)
       : bag_path_(bag_path), buffer_bytes_(buffer_bytes) {
     for (const std::string& topic : progress_topics) latest_[topic] = ros::Time();
-    if (!latest_.empty()) progress_publisher_ = nh.advertise<rosgraph_msgs::Clock>("record/progress", 10, true);
+    if (!latest_.empty())
+      progress_publisher_ = nh.advertise<rosgraph_msgs::Clock>("record/progress", 10, true);
     bag_.open(bag_path_ + ".active", rosbag::bagmode::Write);
   }
 
@@ -109,7 +112,9 @@ class RunRecorder {
     options.datatype = ros::message_traits::datatype<topic_tools::ShapeShifter>();
     options.helper = boost::make_shared<
         ros::SubscriptionCallbackHelperT<const ros::MessageEvent<topic_tools::ShapeShifter const>&>>(
-        [this, topic](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) { receive(event, topic); });
+        [this, topic](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
+          receive(event, topic);
+        });
     subscribers_.push_back(nh.subscribe(options));
     recorded_[topic] = 0;
   }
@@ -194,7 +199,8 @@ class RunRecorder {
   std::map<std::string, std::size_t> recorded_;  // written by the writer only
 };
 
-[[noreturn]] void badParameter(const std::string& name, const std::string& value, const std::string& allowed) {
+[[noreturn]] void badParameter(const std::string& name, const std::string& value,
+                               const std::string& allowed) {
   ROS_FATAL("run_recorder: parameter ~%s = '%s' is invalid (allowed: %s)", name.c_str(), value.c_str(),
             allowed.c_str());
   std::exit(1);
@@ -239,7 +245,8 @@ int main(int argc, char** argv) {
     // refuses time 0; what arrives before waits in the subscriber queues).
     while (!g_stop && ros::ok() && !ros::Time::waitForValid(ros::WallDuration(0.1))) {
     }
-    // Several threads: one topic's callbacks run one at a time, so a cloud being queued holds up no other topic.
+    // Several threads: one topic's callbacks run one at a time, so a cloud being queued holds up no other
+    // topic.
     ros::AsyncSpinner spinner(4);
     spinner.start();
     recorder.writeUntilStopped();

@@ -39,8 +39,9 @@ struct DynamicsNodeOptions {
   int wait_for_subscribers = 0;     // before the first step, wait (up to startup_timeout_s) for this many
                                     // subscribers of truth/chaser/odom
   double duration_s = 0.0;          // run length; 0 = the scenario's simulation.duration_s
-  // > 0: publish step k only once the recorder's record/progress has reached step k - recorder_lag_steps (its
-  // publishers' queues then never overflow); a recorder silent for recorder_timeout_s is no longer waited for.
+  // > 0: publish step k only once the recorder's record/progress has reached step k - recorder_lag_steps
+  // (the publishers' queues to it then never overflow); one that has not caught up within recorder_timeout_s
+  // is no longer waited for.
   int recorder_lag_steps = 0;
   double recorder_timeout_s = 10.0;
   // false: after the last step keep the final state latched until shut down, so that slower subscribers drain
@@ -109,7 +110,9 @@ class DynamicsNode {
     if (options_.recorder_lag_steps > 0) {
       ros::SubscribeOptions so = ros::SubscribeOptions::create<rosgraph_msgs::Clock>(
           "record/progress", 10,
-          [this](const rosgraph_msgs::Clock::ConstPtr& msg) { recorded_until_ = std::max(recorded_until_, msg->clock); },
+          [this](const rosgraph_msgs::Clock::ConstPtr& msg) {
+            recorded_until_ = std::max(recorded_until_, msg->clock);
+          },
           ros::VoidPtr(), &command_queue_);
       progress_sub_ = nh.subscribe(so);
     }
@@ -230,9 +233,11 @@ class DynamicsNode {
       command_queue_.callAvailable(ros::WallDuration(0.002));
       if (ros::WallTime::now() > deadline) {
         recorder_gone_ = true;
-        ROS_ERROR("dynamics: the recorder's record/progress is at t = %.3f s, %d steps behind t = %.3f s, after "
-                  "%.1f s wall: no longer waiting for it (the bag may lack messages from here on)",
-                  recorded_until_.toSec(), options_.recorder_lag_steps, sim_.time(), options_.recorder_timeout_s);
+        ROS_ERROR(
+            "dynamics: the recorder's record/progress is at t = %.3f s, more than %d steps behind t = %.3f "
+            "s, "
+            "after %.1f s wall: no longer waiting for it (the bag may lack messages from here on)",
+            recorded_until_.toSec(), options_.recorder_lag_steps, sim_.time(), options_.recorder_timeout_s);
         return;
       }
     }
