@@ -235,7 +235,8 @@ class DynamicsNode {
         recorder_gone_ = true;
         ROS_ERROR(
             "dynamics: the recorder's record/progress is at t = %.3f s, more than %d steps behind "
-            "t = %.3f s, after %.1f s wall: no longer waiting for it (the bag may lack messages from here on)",
+            "t = %.3f s, after %.1f s wall: no longer waiting for it (the bag may lack messages from here "
+            "on)",
             recorded_until_.toSec(), options_.recorder_lag_steps, sim_.time(), options_.recorder_timeout_s);
         return;
       }
