@@ -115,7 +115,7 @@ class RunRecorder {
         [this, topic](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
           receive(event, topic);
         });
-    subscribers_.push_back(nh.subscribe(options));
+    subscribers_[topic] = nh.subscribe(options);
     recorded_[topic] = 0;
   }
 
@@ -135,7 +135,10 @@ class RunRecorder {
       bag_.write(next.topic, next.receipt_time, *next.message, next.connection_header);
       ++recorded_[next.topic];
     }
-    subscribers_.clear();
+    {
+      std::lock_guard<std::mutex> lock(progress_mutex_);  // advance() reads them
+      subscribers_.clear();
+    }
     bag_.close();
     if (std::rename((bag_path_ + ".active").c_str(), bag_path_.c_str()) != 0)
       ROS_ERROR("run_recorder: could not rename %s.active to %s", bag_path_.c_str(), bag_path_.c_str());
@@ -174,8 +177,15 @@ class RunRecorder {
     }
     std::lock_guard<std::mutex> lock(progress_mutex_);
     latest_[topic] = std::max(latest_[topic], stamp);
-    ros::Time oldest = latest_.begin()->second;
-    for (const auto& entry : latest_) oldest = std::min(oldest, entry.second);
+    // A progress topic with no publisher (its node died; until it is respawned) holds nothing back: the
+    // lockstep goes on without it (guidance holds), and so would the dynamics' wait for the recorder, for
+    // recorder_timeout_s and then for good.
+    ros::Time oldest = latest_[topic];
+    for (const auto& [name, latest] : latest_) {
+      const auto subscriber = subscribers_.find(name);
+      if (subscriber == subscribers_.end() || subscriber->second.getNumPublishers() > 0)
+        oldest = std::min(oldest, latest);
+    }
     if (oldest <= progress_) return;
     progress_ = oldest;
     rosgraph_msgs::Clock progress;
@@ -190,7 +200,7 @@ class RunRecorder {
   ros::Time progress_;
   ros::Publisher progress_publisher_;
   rosbag::Bag bag_;
-  std::vector<ros::Subscriber> subscribers_;
+  std::map<std::string, ros::Subscriber> subscribers_;  // by topic
   std::mutex mutex_;
   std::condition_variable received_;
   std::deque<Received> held_;
