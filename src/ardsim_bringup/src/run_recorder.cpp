@@ -9,7 +9,7 @@
 // /truth/chaser/odom messages at 208 s ("Incoming queue was full for topic /pose/error" in its debug log).
 //
 // It also keeps up with the lockstep rather than lose messages: it publishes record/progress
-// (rosgraph_msgs/Clock, latched), the latest stamp up to which every progress topic has been received, and
+// (rosgraph_msgs/Clock, latched), the latest stamp up to which every progress topic has been written, and
 // the dynamics (~recorder_lag_steps) does not run more than so many steps ahead of it. A publisher's queue to
 // the recorder then never overflows, however slow the disk or loaded the machine. (Outside the lockstep, this
 // recorder fell 2500 steps behind on the dynamics' topics while two default runs shared 2 cores, and the
@@ -134,11 +134,9 @@ class RunRecorder {
       lock.unlock();
       bag_.write(next.topic, next.receipt_time, *next.message, next.connection_header);
       ++recorded_[next.topic];
+      if (latest_.count(next.topic) > 0) markWritten(next.topic, *next.message);
     }
-    {
-      std::lock_guard<std::mutex> lock(progress_mutex_);  // advance() reads them
-      subscribers_.clear();
-    }
+    subscribers_.clear();
     bag_.close();
     if (std::rename((bag_path_ + ".active").c_str(), bag_path_.c_str()) != 0)
       ROS_ERROR("run_recorder: could not rename %s.active to %s", bag_path_.c_str(), bag_path_.c_str());
@@ -152,7 +150,6 @@ class RunRecorder {
  private:
   void receive(const ros::MessageEvent<topic_tools::ShapeShifter const>& event, const std::string& topic) {
     Received r{topic, ros::Time::now(), event.getMessage(), event.getConnectionHeaderPtr()};
-    if (latest_.count(topic) > 0) advance(topic, *r.message);
     {
       std::lock_guard<std::mutex> lock(mutex_);
       held_bytes_ += r.message->size();
@@ -168,14 +165,15 @@ class RunRecorder {
     received_.notify_one();
   }
 
-  void advance(const std::string& topic, const topic_tools::ShapeShifter& message) {
+  // Progress is counted once written, not received (the lockstep then waits for the disk too, rather than
+  // fill buffer_mb and drop), by the writer thread alone.
+  void markWritten(const std::string& topic, const topic_tools::ShapeShifter& message) {
     ros::Time stamp;
     if (!headerStamp(message, &stamp)) {
       ROS_ERROR_THROTTLE(5.0, "run_recorder: progress topic %s (%s) has no header: it cannot mark a step",
                          topic.c_str(), message.getDataType().c_str());
       return;
     }
-    std::lock_guard<std::mutex> lock(progress_mutex_);
     latest_[topic] = std::max(latest_[topic], stamp);
     // A progress topic with no publisher (its node died; until it is respawned) holds nothing back: the
     // lockstep goes on without it (guidance holds), and so would the dynamics' wait for the recorder, for
@@ -195,8 +193,7 @@ class RunRecorder {
 
   const std::string bag_path_;
   const std::size_t buffer_bytes_;
-  std::mutex progress_mutex_;
-  std::map<std::string, ros::Time> latest_;  // by progress topic: the latest stamp received
+  std::map<std::string, ros::Time> latest_;  // by progress topic: the latest stamp written
   ros::Time progress_;
   ros::Publisher progress_publisher_;
   rosbag::Bag bag_;
