@@ -62,20 +62,23 @@ struct Received {
   boost::shared_ptr<ros::M_string> connection_header;
 };
 
-// The stamp of a message whose first field is a std_msgs/Header (seq, then stamp), read from its serialized
-// bytes; false for other types.
-bool headerStamp(const topic_tools::ShapeShifter& message, ros::Time* stamp) {
-  std::istringstream definition(message.getMessageDefinition());
-  std::string line;
-  while (std::getline(definition, line)) {
+// Whether a message type's first field is a std_msgs/Header, from its definition.
+bool startsWithHeader(const std::string& definition_text) {
+  std::istringstream definition(definition_text);
+  for (std::string line; std::getline(definition, line);) {
     const std::size_t start = line.find_first_not_of(" \t");
     if (start == std::string::npos || line[start] == '#') continue;
     std::istringstream field(line.substr(start));
     std::string type;
     field >> type;
-    if (type != "Header" && type != "std_msgs/Header") return false;
-    break;
+    return type == "Header" || type == "std_msgs/Header";
   }
+  return false;
+}
+
+// The header stamp (after its seq) of a message that starts with a std_msgs/Header, from its serialized
+// bytes.
+bool headerStamp(const topic_tools::ShapeShifter& message, ros::Time* stamp) {
   if (message.size() < 12) return false;
   // ShapeShifter hands out its bytes only by copying them into a stream.
   struct Bytes {
@@ -93,13 +96,18 @@ bool headerStamp(const topic_tools::ShapeShifter& message, ros::Time* stamp) {
   return true;
 }
 
+struct ProgressTopic {
+  ros::Time latest;      // the latest stamp written
+  int with_header = -1;  // its type starts with a std_msgs/Header: 1 / 0, -1 before its first message
+};
+
 class RunRecorder {
  public:
   RunRecorder(const std::string& bag_path, std::size_t buffer_bytes,
               const std::vector<std::string>& progress_topics, ros::NodeHandle& nh)
       : bag_path_(bag_path), buffer_bytes_(buffer_bytes) {
-    for (const std::string& topic : progress_topics) latest_[topic] = ros::Time();
-    if (!latest_.empty())
+    for (const std::string& topic : progress_topics) progress_topics_[topic] = ProgressTopic{};
+    if (!progress_topics_.empty())
       progress_publisher_ = nh.advertise<rosgraph_msgs::Clock>("record/progress", 10, true);
     bag_.open(bag_path_ + ".active", rosbag::bagmode::Write);
   }
@@ -134,7 +142,8 @@ class RunRecorder {
       lock.unlock();
       bag_.write(next.topic, next.receipt_time, *next.message, next.connection_header);
       ++recorded_[next.topic];
-      if (latest_.count(next.topic) > 0) markWritten(next.topic, *next.message);
+      const auto progress_topic = progress_topics_.find(next.topic);
+      if (progress_topic != progress_topics_.end()) markWritten(&progress_topic->second, *next.message);
     }
     subscribers_.clear();
     bag_.close();
@@ -167,22 +176,23 @@ class RunRecorder {
 
   // Progress is counted once written, not received (the lockstep then waits for the disk too, rather than
   // fill buffer_mb and drop), by the writer thread alone.
-  void markWritten(const std::string& topic, const topic_tools::ShapeShifter& message) {
+  void markWritten(ProgressTopic* written, const topic_tools::ShapeShifter& message) {
+    if (written->with_header < 0) written->with_header = startsWithHeader(message.getMessageDefinition());
     ros::Time stamp;
-    if (!headerStamp(message, &stamp)) {
-      ROS_ERROR_THROTTLE(5.0, "run_recorder: progress topic %s (%s) has no header: it cannot mark a step",
-                         topic.c_str(), message.getDataType().c_str());
+    if (written->with_header == 0 || !headerStamp(message, &stamp)) {
+      ROS_ERROR_THROTTLE(5.0, "run_recorder: a progress topic's type %s has no header: it cannot mark a step",
+                         message.getDataType().c_str());
       return;
     }
-    latest_[topic] = std::max(latest_[topic], stamp);
+    written->latest = std::max(written->latest, stamp);
     // A progress topic with no publisher (its node died; until it is respawned) holds nothing back: the
     // lockstep goes on without it (guidance holds), and so would the dynamics' wait for the recorder, for
     // recorder_timeout_s and then for good.
-    ros::Time oldest = latest_[topic];
-    for (const auto& [name, latest] : latest_) {
+    ros::Time oldest = written->latest;
+    for (const auto& [name, topic] : progress_topics_) {
       const auto subscriber = subscribers_.find(name);
       if (subscriber == subscribers_.end() || subscriber->second.getNumPublishers() > 0)
-        oldest = std::min(oldest, latest);
+        oldest = std::min(oldest, topic.latest);
     }
     if (oldest <= progress_) return;
     progress_ = oldest;
@@ -193,7 +203,7 @@ class RunRecorder {
 
   const std::string bag_path_;
   const std::size_t buffer_bytes_;
-  std::map<std::string, ros::Time> latest_;  // by progress topic: the latest stamp written
+  std::map<std::string, ProgressTopic> progress_topics_;
   ros::Time progress_;
   ros::Publisher progress_publisher_;
   rosbag::Bag bag_;
