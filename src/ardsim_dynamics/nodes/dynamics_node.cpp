@@ -20,6 +20,7 @@
 #include <geometry_msgs/WrenchStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/callback_queue.h>
+#include <ros/master.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <tf2_msgs/TFMessage.h>
@@ -92,14 +93,11 @@ class DynamicsNode {
     const std::uint32_t queue = options_.free_run ? 100000 : 1000;
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", queue, true);
     target_pub_ = nh.advertise<nav_msgs::Odometry>("truth/target/odom", queue, true);
+    chaser_pub_ = nh.advertise<nav_msgs::Odometry>("truth/chaser/odom", queue, true);
     relative_pub_ = nh.advertise<nav_msgs::Odometry>("truth/relative", queue, true);
     applied_pub_ = nh.advertise<geometry_msgs::WrenchStamped>("dynamics/applied_wrench", queue);
     tf_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf", queue);
     contact_pub_ = nh.advertise<ardsim_msgs::ContactEvent>("dynamics/contact", 1, true);
-    // Last: the first step waits for its subscribers (wait_for_subscribers), and a subscriber of all of these
-    // (the recorder) connects to them in the order they were advertised; advertised third, the recorder's /tf
-    // connection came up after it and a short run's bag lacked the first 5 /tf messages.
-    chaser_pub_ = nh.advertise<nav_msgs::Odometry>("truth/chaser/odom", queue, true);
     if (!options_.free_run) {
       ros::SubscribeOptions so = ros::SubscribeOptions::create<geometry_msgs::WrenchStamped>(
           "guidance/command", 10,
@@ -164,6 +162,29 @@ class DynamicsNode {
            chaser_pub_.getNumSubscribers() < static_cast<std::uint32_t>(options_.wait_for_subscribers) &&
            ros::WallTime::now() < deadline)
       ros::WallDuration(0.01).sleep();
+    // Then until every node the master lists as a subscriber of a topic of ours is connected to it: a node
+    // connects to each topic on its own, and the recorder, connected to truth/chaser/odom, lacked the first
+    // 30 truth/target/odom of a short run.
+    while (ros::ok() && ros::WallTime::now() < deadline && !allSubscribersConnected())
+      ros::WallDuration(0.01).sleep();
+  }
+
+  bool allSubscribersConnected() const {
+    XmlRpc::XmlRpcValue args, result, payload;
+    args[0] = ros::this_node::getName();
+    if (!ros::master::execute("getSystemState", args, result, payload, false)) return true;  // cannot tell
+    const ros::Publisher* publishers[] = {&clock_pub_,   &target_pub_, &chaser_pub_, &relative_pub_,
+                                          &applied_pub_, &tf_pub_,     &contact_pub_};
+    XmlRpc::XmlRpcValue& subscriptions = payload[1];  // [[topic, [node, ...]], ...]
+    for (int i = 0; i < subscriptions.size(); ++i) {
+      const std::string topic = subscriptions[i][0];
+      for (const ros::Publisher* publisher : publishers) {
+        if (publisher->getTopic() == topic &&
+            publisher->getNumSubscribers() < static_cast<std::uint32_t>(subscriptions[i][1].size()))
+          return false;
+      }
+    }
+    return true;
   }
 
   void publishContact(const ContactEvent& event) {
