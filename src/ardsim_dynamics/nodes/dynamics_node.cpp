@@ -10,6 +10,7 @@
 // and the node stops advancing.
 #include <ardsim_msgs/ContactEvent.h>
 #include <ardsim_msgs/log_throttle.h>
+#include <ardsim_msgs/subscriber_wait.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,7 +21,6 @@
 #include <geometry_msgs/WrenchStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/callback_queue.h>
-#include <ros/master.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <tf2_msgs/TFMessage.h>
@@ -162,29 +162,11 @@ class DynamicsNode {
            chaser_pub_.getNumSubscribers() < static_cast<std::uint32_t>(options_.wait_for_subscribers) &&
            ros::WallTime::now() < deadline)
       ros::WallDuration(0.01).sleep();
-    // Then until every node the master lists as a subscriber of a topic of ours is connected to it: a node
-    // connects to each topic on its own, and the recorder, connected to truth/chaser/odom, lacked the first
-    // 30 truth/target/odom of a short run.
-    while (ros::ok() && ros::WallTime::now() < deadline && !allSubscribersConnected())
-      ros::WallDuration(0.01).sleep();
-  }
-
-  bool allSubscribersConnected() const {
-    XmlRpc::XmlRpcValue args, result, payload;
-    args[0] = ros::this_node::getName();
-    if (!ros::master::execute("getSystemState", args, result, payload, false)) return true;  // cannot tell
-    const ros::Publisher* publishers[] = {&clock_pub_,   &target_pub_, &chaser_pub_, &relative_pub_,
-                                          &applied_pub_, &tf_pub_,     &contact_pub_};
-    XmlRpc::XmlRpcValue& subscriptions = payload[1];  // [[topic, [node, ...]], ...]
-    for (int i = 0; i < subscriptions.size(); ++i) {
-      const std::string topic = subscriptions[i][0];
-      for (const ros::Publisher* publisher : publishers) {
-        if (publisher->getTopic() == topic &&
-            publisher->getNumSubscribers() < static_cast<std::uint32_t>(subscriptions[i][1].size()))
-          return false;
-      }
-    }
-    return true;
+    // Then until every node the master lists as a subscriber of a topic of ours is connected to it (the
+    // recorder, connected to truth/chaser/odom, lacked the first 30 truth/target/odom of a short run).
+    for (const ros::Publisher* publisher :
+         {&clock_pub_, &target_pub_, &chaser_pub_, &relative_pub_, &applied_pub_, &tf_pub_, &contact_pub_})
+      ardsim_msgs::waitForRegisteredSubscribers(*publisher, deadline, "dynamics");
   }
 
   void publishContact(const ContactEvent& event) {

@@ -1,6 +1,7 @@
 #include "lidar_driver.h"
 #include <ardsim_msgs/log_throttle.h>
 #include <ardsim_msgs/param_read.h>
+#include <ardsim_msgs/subscriber_wait.h>
 
 #include <cmath>
 #include <limits>
@@ -8,8 +9,6 @@
 #include <stdexcept>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
-#include <ros/master.h>
-#include <xmlrpcpp/XmlRpcValue.h>
 
 #include "ardsim_description/frames.h"
 #include "conversions.h"
@@ -19,34 +18,6 @@ namespace ardsim_lidar {
 namespace {
 
 constexpr std::uint32_t kRecorderQueue = 100;  // frames queued per subscriber connection
-
-// How many nodes the master lists as subscribers of topic (0 if it cannot be asked).
-int registeredSubscribers(const std::string& topic) {
-  XmlRpc::XmlRpcValue args, result, payload;
-  args[0] = ros::this_node::getName();
-  if (!ros::master::execute("getSystemState", args, result, payload, true) || payload.size() < 2) return 0;
-  XmlRpc::XmlRpcValue& subscribers = payload[1];
-  for (int i = 0; i < subscribers.size(); ++i)
-    if (static_cast<std::string>(subscribers[i][0]) == topic) return subscribers[i][1].size();
-  return 0;
-}
-
-// Waits (up to timeout_s of wall time) until every node registered as a subscriber of the publisher's topic
-// is connected to it. A frame goes only to the subscribers connected when it is published, and the dynamics
-// starts stepping as soon as this node listens to the truth: a recorder whose connection was still being made
-// then missed the first 25 frames of a run at 30x real time.
-void waitForRegisteredSubscribers(const ros::Publisher& publisher, double timeout_s) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  int registered = 0;
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    registered = registeredSubscribers(publisher.getTopic());
-    if (static_cast<int>(publisher.getNumSubscribers()) >= registered) return;
-    ros::WallDuration(0.01).sleep();
-  }
-  ROS_WARN("lidar: %d of %d registered subscribers of %s connected after %.0f s; starting anyway",
-           static_cast<int>(publisher.getNumSubscribers()), registered, publisher.getTopic().c_str(),
-           timeout_s);
-}
 
 template <typename T>
 void read(const ros::NodeHandle& nh, const std::string& name, T* value) {
@@ -174,8 +145,9 @@ LidarDriver::LidarDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
   diagnostics_publisher_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", kRecorderQueue);
   synchronizer_.registerCallback(&LidarDriver::onTruth, this);
   // Listen to the truth (which lets the dynamics start) only once the frames' subscribers are connected.
-  waitForRegisteredSubscribers(points_publisher_, 10.0);
-  waitForRegisteredSubscribers(range_publisher_, 10.0);
+  for (const ros::Publisher* frames : {&points_publisher_, &range_publisher_})
+    ardsim_msgs::waitForRegisteredSubscribers(*frames, ros::WallTime::now() + ros::WallDuration(10.0),
+                                              "lidar");
   target_subscriber_.subscribe(nh, "truth/target/odom", 10);
   chaser_subscriber_.subscribe(nh, "truth/chaser/odom", 10);
   ROS_INFO("lidar: %s, %dx%d, %.1f deg, range %.2f..%.0f m, noise %s, seed %llu; EGL %s, GL_RENDERER %s",
