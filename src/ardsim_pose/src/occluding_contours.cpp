@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+
 #include "tukey_weight.h"
 
 namespace ardsim_pose {
@@ -209,7 +211,7 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) {
     if (hi < window_begin || lo > window_end) continue;
     // The triangle's edges crossing the line: the span between the crossings, depth by 1/z (linear in the
     // image) at each.
-    float a0 = std::numeric_limits<float>::infinity(), a1 = -a0, inv_z1 = 0.0f;
+    float a0 = std::numeric_limits<float>::infinity(), a1 = -a0, inv_z1 = 0.0f, slope1 = 0.0f;
     for (int e = 0; e < 3; ++e) {
       const Eigen::Vector3f& A = p.corners[e];
       const Eigen::Vector3f& B = p.corners[(e + 1) % 3];
@@ -222,10 +224,11 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) {
       if (along > a1) {
         a1 = along;
         inv_z1 = 1.0f / A.z() + s * (1.0f / B.z() - 1.0f / A.z());
+        slope1 = across_rows ? (B.y() - A.y()) / (B.x() - A.x()) : (B.x() - A.x()) / (B.y() - A.y());
       }
     }
     if (!(a1 >= a0) || std::abs(1.0f / inv_z1 - pair.depth_m) > depth_jump_m_) continue;
-    covers_.push_back({a0, a1, 1.0f / inv_z1});
+    covers_.push_back({a0, a1, 1.0f / inv_z1, slope1});
   }
   if (covers_.empty()) return found;
   std::sort(covers_.begin(), covers_.end(),
@@ -234,7 +237,7 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) {
   constexpr float kJoinPx = 1e-3f;
   constexpr float kThinPx = 1.0f;
   bool have = false;
-  Cover chosen{0.0f, 0.0f, 0.0f}, span = covers_.front();
+  Cover chosen{0.0f, 0.0f, 0.0f, 0.0f}, span = covers_.front();
   auto consider = [&](const Cover& s) {
     if (s.along0 <= 0.0f && s.along1 >= 0.0f) {  // covers the return's centre
       chosen = s;
@@ -249,7 +252,7 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) {
   for (std::size_t k = 1; k < covers_.size() && !covering; ++k) {
     const Cover& c = covers_[k];
     if (c.along0 <= span.along1 + kJoinPx) {
-      if (c.along1 > span.along1) span.along1 = c.along1, span.depth1 = c.depth1;
+      if (c.along1 > span.along1) span.along1 = c.along1, span.depth1 = c.depth1, span.slope1 = c.slope1;
       continue;
     }
     covering = consider(span);
@@ -260,6 +263,7 @@ OccludingContours::Found OccludingContours::find(const Pair& pair) {
   if (!have || chosen.along1 > window_end - 0.5f || chosen.along1 < window_begin) return found;
   found.ok = true;
   found.offset_px = chosen.along1 - 0.5f;
+  found.slope = chosen.slope1;
   const float along = origin + direction * chosen.along1;
   found.point =
       across_rows ? Eigen::Vector3d(line, along, chosen.depth1) : Eigen::Vector3d(along, line, chosen.depth1);
@@ -315,6 +319,127 @@ int OccludingContours::accumulate(bool with_boresight_rotation, const Eigen::Iso
     ++rows;
   }
   return rows;
+}
+
+namespace {
+// The half-plane n . x <= b of a convex polygon.
+void clipPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& n, double b,
+                 std::vector<Eigen::Vector2d>* out) {
+  out->clear();
+  for (std::size_t k = 0; k < polygon.size(); ++k) {
+    const Eigen::Vector2d& p = polygon[k];
+    const Eigen::Vector2d& q = polygon[(k + 1) % polygon.size()];
+    const double fp = n.dot(p) - b, fq = n.dot(q) - b;
+    if (fp <= 0.0) out->push_back(p);
+    if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) out->push_back(p + (fp / (fp - fq)) * (q - p));
+  }
+}
+}  // namespace
+
+int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m,
+                                           double reach_px, double floor_px, double min_information,
+                                           Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g) {
+  if (pairs_.empty() || candidates_.empty()) return 0;
+  project(T_lidar_target);
+  // Steeper contours turn a small error of the pose's rotation into a large one along the pair.
+  constexpr double kMaxSlope = 2.0;
+  const double f = std::min(intrinsics_.fx, intrinsics_.fy);
+  strips_.clear();
+  double depth_sum = 0.0;
+  for (const Pair& pair : pairs_) {
+    const Found found = find(pair);
+    if (!found.ok || std::abs(found.slope) > kMaxSlope || std::abs(found.offset_px) > reach_px + 0.5)
+      continue;
+    const double Z = found.point.z();
+    const bool across_rows = pair.dv != 0;
+    const double direction = across_rows ? pair.dv : pair.du;
+    // A lateral translation moves the model's contour across the pair's line by its image motion along the
+    // line's axis, less the contour's slope times its motion along the line.
+    const Eigen::Vector2d a =
+        direction * (across_rows ? Eigen::Vector2d(-found.slope * intrinsics_.fx / Z, intrinsics_.fy / Z)
+                                 : Eigen::Vector2d(intrinsics_.fx / Z, -found.slope * intrinsics_.fy / Z));
+    strips_.push_back({a, found.offset_px});
+    depth_sum += Z;
+  }
+  if (strips_.empty()) return 0;
+  // The vote: each pair's strip |offset + a . d| <= 1/2 over a grid of translations d within reach_px at the
+  // pairs' mean depth, by rows of a difference array.
+  constexpr int kHalfCells = 40, kCells = 2 * kHalfCells + 1;
+  const double reach_m = reach_px * depth_sum / strips_.size() / f, cell_m = reach_m / kHalfCells;
+  const double row0_dy = -kHalfCells * cell_m;
+  votes_.assign(static_cast<std::size_t>(kCells) * (kCells + 1), 0);
+  for (const Strip& s : strips_) {
+    // In cells, with d = 0 at cell kHalfCells: the strip at row j spans columns [first + j * step,
+    // first + j * step + width].
+    if (std::abs(s.a.x()) * reach_m < 1e-3) {  // parallel to the x axis: whole rows or none
+      for (int j = 0; j < kCells; ++j) {
+        if (std::abs(s.offset_px + s.a.y() * (row0_dy + j * cell_m)) > 0.5) continue;
+        ++votes_[j * (kCells + 1)];
+        --votes_[j * (kCells + 1) + kCells];
+      }
+      continue;
+    }
+    const double inverse = 1.0 / (s.a.x() * cell_m);
+    const double width = std::abs(inverse);
+    const double step = -s.a.y() * cell_m * inverse;
+    double first = ((s.a.x() > 0.0 ? -0.5 : 0.5) - s.offset_px - s.a.y() * row0_dy) * inverse + kHalfCells;
+    for (int j = 0; j < kCells; ++j, first += step) {
+      const int i0 = std::max(0, static_cast<int>(std::ceil(first)));
+      const int i1 = std::min(kCells - 1, static_cast<int>(std::floor(first + width)));
+      if (i0 > i1) continue;
+      ++votes_[j * (kCells + 1) + i0];
+      --votes_[j * (kCells + 1) + i1 + 1];
+    }
+  }
+  // The winner: the most votes, nearest the pose among equals.
+  int best = 0, best_i = kHalfCells, best_j = kHalfCells, best_r2 = 0;
+  for (int j = 0; j < kCells; ++j) {
+    int count = 0;
+    for (int i = 0; i < kCells; ++i) {
+      count += votes_[j * (kCells + 1) + i];
+      const int r2 = (i - kHalfCells) * (i - kHalfCells) + (j - kHalfCells) * (j - kHalfCells);
+      if (count > best || (count == best && r2 < best_r2)) best = count, best_i = i, best_j = j, best_r2 = r2;
+    }
+  }
+  if (best == 0) return 0;
+  const Eigen::Vector2d winner((best_i - kHalfCells) * cell_m, (best_j - kHalfCells) * cell_m);
+  // The exact intersection of the strips that hold the winner (it holds it: never empty).
+  polygon_ = {{-reach_m, -reach_m}, {reach_m, -reach_m}, {reach_m, reach_m}, {-reach_m, reach_m}};
+  int used = 0;
+  for (const Strip& s : strips_) {
+    if (std::abs(s.offset_px + s.a.dot(winner)) > 0.5) continue;
+    clipPolygon(polygon_, s.a, 0.5 - s.offset_px, &clipped_);
+    clipPolygon(clipped_, -s.a, 0.5 + s.offset_px, &polygon_);
+    ++used;
+  }
+  // Its centroid and covariance as of a uniform distribution over it (fan of triangles).
+  double area = 0.0;
+  Eigen::Vector2d moment1 = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d moment2 = Eigen::Matrix2d::Zero();
+  for (std::size_t k = 1; k + 1 < polygon_.size(); ++k) {
+    const Eigen::Vector2d &p0 = polygon_[0], &p1 = polygon_[k], &p2 = polygon_[k + 1];
+    const Eigen::Vector2d e1 = p1 - p0, e2 = p2 - p0;
+    const double t = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    const Eigen::Vector2d sum = p0 + p1 + p2;
+    area += t;
+    moment1 += t * sum / 3.0;
+    moment2 += (t / 12.0) *
+               (p0 * p0.transpose() + p1 * p1.transpose() + p2 * p2.transpose() + sum * sum.transpose());
+  }
+  if (!(area > 0.0)) return 0;
+  const Eigen::Vector2d mean = moment1 / area;
+  const double floor_m = floor_px * depth_sum / strips_.size() / f;
+  const Eigen::Matrix2d covariance =
+      moment2 / area - mean * mean.transpose() + floor_m * floor_m * Eigen::Matrix2d::Identity();
+  // No weaker than min_information in any direction: the caller's limit below which the directions count as
+  // unobserved and the planes' coarser means take over.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen((sigma_m * sigma_m) * covariance.inverse());
+  const Eigen::Matrix2d information = eigen.eigenvectors() *
+                                      eigen.eigenvalues().cwiseMax(min_information).asDiagonal() *
+                                      eigen.eigenvectors().transpose();
+  H->topLeftCorner<2, 2>() += information;
+  g->head<2>() += information * mean;
+  return used;
 }
 
 }  // namespace ardsim_pose

@@ -76,6 +76,13 @@ struct IcpOptions {
   // the port within ~2 mm, the contours cost a 30 m benchmark frame 10 % of its instructions; with 12, the
   // hand-over gtest's frame at 12 m slid 49 mm on the offsets), 0 (Hubble).
   double contour_max_depth_m = 16.0;
+  // Tracking, where the model's nearest predicted surface is at least this far (m), the contours place the
+  // lateral translation by consensus, all pairs at once (OccludingContours::accumulateConsensus), instead of
+  // each pair's midpoint: a pixel there is large against what the other unknowns' errors move the contours
+  // (Hubble's bulkhead rim at 30-50 m, the approach datasets: port position RMS 0.11-0.14 -> 0.08-0.12 cm).
+  // Nearer, their exact intersection was biased (Hubble's approach dataset inside 10 m, ICP alone: 1.2 ->
+  // 6.6 mm; hubble_hold's roll at 10-20 m, which the composite takes from ICP: worst frame 0.07 -> 0.12 deg).
+  double contour_consensus_min_depth_m = 25.0;
   double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
   // Tracking: the rotation about the boresight is held near the prediction with this standard deviation
   // (deg; a prior in the normal equations): where the scan barely observes it (a near-symmetric docking
@@ -270,9 +277,10 @@ class IcpTracker : public PoseMethod {
   // Adds the occluding contours' rows at a.T to the normal equations (H, g) of a twist about a.centre
   // (IcpOptions::contour_sigma_px): the frame's edge pairs once, the model points near them again once the
   // pose moved a pixel or the visibility changed; with_boresight_rotation: the rows measure the rotation
-  // about the boresight too. Whether any row was added.
-  bool addContours(const Alignment& a, bool with_boresight_rotation, Eigen::Matrix<double, 6, 6>* H,
-                   Eigen::Matrix<double, 6, 1>* g);
+  // about the boresight too (else, at contour_consensus_min_depth_m and beyond, the lateral translation by
+  // consensus, with no less information than min_information). Whether any row was added.
+  bool addContours(const Alignment& a, bool with_boresight_rotation, double min_information,
+                   Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
   // The smallest eigenvalue of H_scaled's first five unknowns (all but the boresight rotation).
   double weakestOfFive(const Eigen::Matrix<double, 6, 6>& H_scaled) const;
   // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the

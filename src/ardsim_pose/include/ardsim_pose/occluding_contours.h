@@ -50,6 +50,19 @@ class OccludingContours {
                  const Eigen::Vector3d& centre, double sigma_m, double sigma_px, double limit_px,
                  Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
 
+  // The lateral translation (lidar x, y) alone, as the set of translations that put the model's contour of
+  // every pair between its two pixel centres: the midpoints above share a sub-pixel phase along a straight
+  // edge, and their mean is off by up to half a pixel with the target's position across the pixels (Hubble's
+  // bulkhead rim at 45 m: lateral error periodic in the image position, swinging 7 mm). The pairs vote over
+  // translations within reach_px (a strip each); those holding the winner (a bad pair, a dropout beside the
+  // edge, is outvoted) are intersected exactly; the polygon's centroid is added to (H, g) as a measurement of
+  // (v_x, v_y), with its covariance (of a uniform distribution over it) widened by floor_px, in the units of
+  // sigma_m, and no less information than min_information in any direction. Returns the pairs intersected
+  // (0: nothing added).
+  int accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m, double reach_px,
+                          double floor_px, double min_information, Eigen::Matrix<double, 6, 6>* H,
+                          Eigen::Matrix<double, 6, 1>* g);
+
  private:
   struct Pair {
     int u = 0, v = 0;    // the return's pixel
@@ -62,6 +75,8 @@ class OccludingContours {
     double offset_px = 0.0;  // the model's contour minus the pair's midpoint, along (du, dv)
     // The contour point: image coordinates (px) and depth (m).
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    // The contour's slope there: its image coordinate along the pair's axis per px along the line.
+    double slope = 0.0;
   };
   // A candidate triangle projected at a pose: its corners (image px, depth m) and image bounds.
   struct Projected {
@@ -72,6 +87,7 @@ class OccludingContours {
   // neighbour), with the depth at along1.
   struct Cover {
     float along0, along1, depth1;
+    float slope1;  // of the triangle's edge at along1, px along the pair's axis per px along its line
   };
   // Projects the candidates at T and lists them by the pixel columns and rows of the pairs' lines they cross.
   void project(const Eigen::Isometry3d& T_lidar_target);
@@ -95,6 +111,15 @@ class OccludingContours {
   std::vector<Projected> projected_;
   std::vector<std::vector<std::uint32_t>> by_column_, by_row_;  // indices into projected_
   std::vector<Cover> covers_;                                   // scratch of find
+  // A pair in accumulateConsensus: its model contour's offset at a lateral translation d (m) from the pose
+  // is offset_px + a . d.
+  struct Strip {
+    Eigen::Vector2d a;  // px/m
+    double offset_px;
+  };
+  std::vector<Strip> strips_;                       // scratch of accumulateConsensus
+  std::vector<int> votes_;                          // scratch: its vote, a difference array by rows
+  std::vector<Eigen::Vector2d> polygon_, clipped_;  // scratch: its intersection
 };
 
 }  // namespace ardsim_pose
