@@ -57,6 +57,7 @@ void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<i
     }
   }
   pairs_.clear();
+  members_.clear();
   column_has_pair_.assign(w, 0);
   row_has_pair_.assign(h, 0);
   // The model's contour is looked for window_px either side of the pair, inside the image.
@@ -336,36 +337,11 @@ void clipPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vecto
 }
 }  // namespace
 
-int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m,
-                                           double reach_px, double floor_px, double min_information,
-                                           Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g) {
-  if (pairs_.empty() || candidates_.empty()) return 0;
-  project(T_lidar_target);
-  // Steeper contours turn a small error of the pose's rotation into a large one along the pair.
-  constexpr double kMaxSlope = 2.0;
-  const double f = std::min(intrinsics_.fx, intrinsics_.fy);
-  strips_.clear();
-  double depth_sum = 0.0;
-  for (const Pair& pair : pairs_) {
-    const Found found = find(pair);
-    if (!found.ok || std::abs(found.slope) > kMaxSlope || std::abs(found.offset_px) > reach_px + 0.5)
-      continue;
-    const double Z = found.point.z();
-    const bool across_rows = pair.dv != 0;
-    const double direction = across_rows ? pair.dv : pair.du;
-    // A lateral translation moves the model's contour across the pair's line by its image motion along the
-    // line's axis, less the contour's slope times its motion along the line.
-    const Eigen::Vector2d a =
-        direction * (across_rows ? Eigen::Vector2d(-found.slope * intrinsics_.fx / Z, intrinsics_.fy / Z)
-                                 : Eigen::Vector2d(intrinsics_.fx / Z, -found.slope * intrinsics_.fy / Z));
-    strips_.push_back({a, found.offset_px});
-    depth_sum += Z;
-  }
-  if (strips_.empty()) return 0;
-  // The vote: each pair's strip |offset + a . d| <= 1/2 over a grid of translations d within reach_px at the
-  // pairs' mean depth, by rows of a difference array.
+Eigen::Vector2d OccludingContours::vote(double reach_m) {
+  // Each strip |offset + a . d| <= 1/2 over a grid of translations d within reach_m, by rows of a difference
+  // array; the winner has the most votes, the nearest the pose among equals.
   constexpr int kHalfCells = 40, kCells = 2 * kHalfCells + 1;
-  const double reach_m = reach_px * depth_sum / strips_.size() / f, cell_m = reach_m / kHalfCells;
+  const double cell_m = reach_m / kHalfCells;
   const double row0_dy = -kHalfCells * cell_m;
   votes_.assign(static_cast<std::size_t>(kCells) * (kCells + 1), 0);
   for (const Strip& s : strips_) {
@@ -401,18 +377,23 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
       if (count > best || (count == best && r2 < best_r2)) best = count, best_i = i, best_j = j, best_r2 = r2;
     }
   }
-  if (best == 0) return 0;
-  const Eigen::Vector2d winner((best_i - kHalfCells) * cell_m, (best_j - kHalfCells) * cell_m);
-  // The exact intersection of the strips that hold the winner (it holds it: never empty).
+  return Eigen::Vector2d((best_i - kHalfCells) * cell_m, (best_j - kHalfCells) * cell_m);
+}
+
+int OccludingContours::intersectMembers(double reach_m) {
   polygon_ = {{-reach_m, -reach_m}, {reach_m, -reach_m}, {reach_m, reach_m}, {-reach_m, reach_m}};
-  int used = 0;
+  int members = 0;
   for (const Strip& s : strips_) {
-    if (std::abs(s.offset_px + s.a.dot(winner)) > 0.5) continue;
+    if (!s.member) continue;
     clipPolygon(polygon_, s.a, 0.5 - s.offset_px, &clipped_);
     clipPolygon(clipped_, -s.a, 0.5 + s.offset_px, &polygon_);
-    ++used;
+    ++members;
   }
-  // Its centroid and covariance as of a uniform distribution over it (fan of triangles).
+  return members;
+}
+
+bool OccludingContours::polygonMoments(Eigen::Vector2d* mean, Eigen::Matrix2d* covariance) const {
+  // Uniform over the polygon, by a fan of triangles.
   double area = 0.0;
   Eigen::Vector2d moment1 = Eigen::Vector2d::Zero();
   Eigen::Matrix2d moment2 = Eigen::Matrix2d::Zero();
@@ -426,11 +407,72 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
     moment2 += (t / 12.0) *
                (p0 * p0.transpose() + p1 * p1.transpose() + p2 * p2.transpose() + sum * sum.transpose());
   }
-  if (!(area > 0.0)) return 0;
-  const Eigen::Vector2d mean = moment1 / area;
+  if (!(area > 0.0)) return false;
+  *mean = moment1 / area;
+  *covariance = moment2 / area - *mean * mean->transpose();
+  return true;
+}
+
+int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m,
+                                           double reach_px, double floor_px, double min_information,
+                                           bool vote_again, Eigen::Matrix<double, 6, 6>* H,
+                                           Eigen::Matrix<double, 6, 1>* g) {
+  if (pairs_.empty() || candidates_.empty()) return 0;
+  if (vote_again) members_.clear();
+  project(T_lidar_target);
+  // Steeper contours turn a small error of the pose's rotation into a large one along the pair.
+  constexpr double kMaxSlope = 2.0;
+  const double f = std::min(intrinsics_.fx, intrinsics_.fy);
+  const bool voting = members_.empty();
+  strips_.clear();
+  double depth_sum = 0.0;
+  for (std::size_t index = 0; index < pairs_.size(); ++index) {
+    const Pair& pair = pairs_[index];
+    if (!voting && !members_[index]) continue;
+    const Found found = find(pair);
+    if (!found.ok || std::abs(found.slope) > kMaxSlope || std::abs(found.offset_px) > reach_px + 0.5)
+      continue;
+    const double Z = found.point.z();
+    const bool across_rows = pair.dv != 0;
+    const double direction = across_rows ? pair.dv : pair.du;
+    // A lateral translation moves the model's contour across the pair's line by its image motion along the
+    // line's axis, less the contour's slope times its motion along the line.
+    const Eigen::Vector2d a =
+        direction * (across_rows ? Eigen::Vector2d(-found.slope * intrinsics_.fx / Z, intrinsics_.fy / Z)
+                                 : Eigen::Vector2d(intrinsics_.fx / Z, -found.slope * intrinsics_.fy / Z));
+    strips_.push_back({a, found.offset_px, index, !voting});
+    depth_sum += Z;
+  }
+  if (strips_.empty()) return 0;
+  const double reach_m = reach_px * depth_sum / strips_.size() / f;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  if (voting) {
+    // The vote once a frame, its winner (a cell's centre) refined: the members are the strips that hold the
+    // centroid of their own intersection, until they stay the same. Later calls intersect the same pairs'
+    // strips unless told to vote again.
+    Eigen::Vector2d point = vote(reach_m);
+    for (int round = 0; round < 5; ++round) {
+      bool changed = false;
+      for (Strip& s : strips_) {
+        const bool member = std::abs(s.offset_px + s.a.dot(point)) <= 0.5;
+        changed = changed || member != s.member;
+        s.member = member;
+      }
+      if (!changed || intersectMembers(reach_m) == 0 || !polygonMoments(&mean, &covariance)) break;
+      point = mean;
+    }
+    members_.assign(pairs_.size(), 0);
+    for (const Strip& s : strips_) members_[s.pair] = s.member;
+  }
+  if (intersectMembers(reach_m) == 0) return 0;
+  if (!polygonMoments(&mean, &covariance)) {
+    // The members' strips moved apart with the pose (their contours on other triangles): vote again.
+    if (voting) return 0;
+    return accumulateConsensus(T_lidar_target, sigma_m, reach_px, floor_px, min_information, true, H, g);
+  }
   const double floor_m = floor_px * depth_sum / strips_.size() / f;
-  const Eigen::Matrix2d covariance =
-      moment2 / area - mean * mean.transpose() + floor_m * floor_m * Eigen::Matrix2d::Identity();
+  covariance += floor_m * floor_m * Eigen::Matrix2d::Identity();
   // No weaker than min_information in any direction: the caller's limit below which the directions count as
   // unobserved and the planes' coarser means take over.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen((sigma_m * sigma_m) * covariance.inverse());
@@ -439,7 +481,8 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
                                       eigen.eigenvectors().transpose();
   H->topLeftCorner<2, 2>() += information;
   g->head<2>() += information * mean;
-  return used;
+  return static_cast<int>(
+      std::count_if(strips_.begin(), strips_.end(), [](const Strip& s) { return s.member; }));
 }
 
 }  // namespace ardsim_pose

@@ -54,14 +54,15 @@ class OccludingContours {
   // every pair between its two pixel centres: the midpoints above share a sub-pixel phase along a straight
   // edge, and their mean is off by up to half a pixel with the target's position across the pixels (Hubble's
   // bulkhead rim at 45 m: lateral error periodic in the image position, swinging 7 mm). The pairs vote over
-  // translations within reach_px (a strip each); those holding the winner (a bad pair, a dropout beside the
-  // edge, is outvoted) are intersected exactly; the polygon's centroid is added to (H, g) as a measurement of
+  // translations within reach_px (a strip each) at the frame's first call and when vote_again; the strips
+  // holding the winner (a bad pair, a dropout beside the edge, is outvoted) are its members until the next
+  // vote, intersected exactly at each call; the polygon's centroid is added to (H, g) as a measurement of
   // (v_x, v_y), with its covariance (of a uniform distribution over it) widened by floor_px, in the units of
-  // sigma_m, and no less information than min_information in any direction. Returns the pairs intersected
+  // sigma_m, and no less information than min_information in any direction. Returns the members intersected
   // (0: nothing added).
   int accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m, double reach_px,
-                          double floor_px, double min_information, Eigen::Matrix<double, 6, 6>* H,
-                          Eigen::Matrix<double, 6, 1>* g);
+                          double floor_px, double min_information, bool vote_again,
+                          Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
 
  private:
   struct Pair {
@@ -116,8 +117,17 @@ class OccludingContours {
   struct Strip {
     Eigen::Vector2d a;  // px/m
     double offset_px;
+    std::size_t pair;  // its index in pairs_
+    bool member = false;
   };
+  // The translation within reach_m of the pose that the most strips_ hold.
+  Eigen::Vector2d vote(double reach_m);
+  // polygon_: the intersection of the member strips within reach_m; returns their number.
+  int intersectMembers(double reach_m);
+  // The mean and covariance of a uniform distribution over polygon_ (false: no area).
+  bool polygonMoments(Eigen::Vector2d* mean, Eigen::Matrix2d* covariance) const;
   std::vector<Strip> strips_;                       // scratch of accumulateConsensus
+  std::vector<std::uint8_t> members_;               // per pair, in the frame's consensus (empty: none yet)
   std::vector<int> votes_;                          // scratch: its vote, a difference array by rows
   std::vector<Eigen::Vector2d> polygon_, clipped_;  // scratch: its intersection
 };
