@@ -31,9 +31,10 @@ constexpr int kFineIterations = 3;
 // window): also Tukey's limit of the contours' offsets (beyond it no pair counts anyway).
 constexpr double kContourWindowPx = 3.0;
 // The contours' consensus (IcpOptions::contour_consensus_min_depth_m): the translations voted over, px either
-// way (a tracking prediction is millimetres off), and the floor of its spread, px (the model's and the other
-// unknowns' part; Hubble's 24 approach datasets at 30-50 m: port position RMS 0.08-0.12 cm with 0.02 or 0.04,
-// 0.06-0.10 with 0.01 but the worst frame within 3x the RMS in 8 of 24 runs instead of 18-19).
+// way (a tracking prediction is millimetres off); the floor of its spread, px (the model's and the other
+// unknowns' part: 0.02 and 0.04 alike on Hubble's approach datasets, 0.01 put the worst frame at 30-50 m over
+// 3x the RMS in 16 of 24 runs instead of 5-6; HISTORY.md, session 37); and how far the pose moves, px, before
+// the pairs vote again.
 constexpr double kConsensusReachPx = 2.0;
 constexpr double kConsensusFloorPx = 0.02;
 constexpr double kConsensusRevotePx = 0.25;

@@ -1,7 +1,8 @@
 // The occluding contours that ICP measures where its planes leave directions weak: the edge pairs of a frame
 // (a return beside none or one far behind, never at the image's border or in a retro-reflector's bloom),
 // and Hubble's rim placed across the boresight far better than a pixel from a pose half a footprint off,
-// where the tangential offsets carry no information.
+// where the tangential offsets carry no information, by each pair's midpoint and, from almost a footprint
+// off, by the consensus of all pairs (better than the midpoints, and with returns knocked out along the rim).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

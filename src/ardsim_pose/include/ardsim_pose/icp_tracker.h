@@ -79,7 +79,7 @@ struct IcpOptions {
   // Tracking, where the model's nearest predicted surface is at least this far (m), the contours place the
   // lateral translation by consensus, all pairs at once (OccludingContours::accumulateConsensus), instead of
   // each pair's midpoint: a pixel there is large against what the other unknowns' errors move the contours
-  // (Hubble's bulkhead rim at 30-50 m, the approach datasets: port position RMS 0.11-0.14 -> 0.08-0.12 cm).
+  // (Hubble's bulkhead rim at 30-50 m, the approach datasets: port position RMS 0.11-0.14 -> 0.07-0.11 cm).
   // Nearer, their exact intersection was biased (Hubble's approach dataset inside 10 m, ICP alone: 1.2 ->
   // 6.6 mm; hubble_hold's roll at 10-20 m, which the composite takes from ICP: worst frame 0.07 -> 0.12 deg).
   double contour_consensus_min_depth_m = 25.0;
