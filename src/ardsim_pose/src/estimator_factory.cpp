@@ -92,8 +92,9 @@ void applyTargetDefaults(PoseConfig* config) {
   config->mode.close_enter_range_m = hubble ? 20.0 : defaults.mode.close_enter_range_m;
   config->mode.close_exit_range_m = hubble ? 22.0 : defaults.mode.close_exit_range_m;
   config->mode.close_enter_fill = hubble ? 0.25 : defaults.mode.close_enter_fill;
-  // Hubble's port from 30 m in is placed by the ring (ICP's ~2 cm become a few mm), its tilt down to 10 m by
-  // ICP (the ring's ~0.05 deg become ~0.02): the composite pose (EstimatorOptions). The ISS's from the
+  // Hubble's port from 20 m in is placed by the ring (from 30 m until session 37, when ICP's ~2 cm there
+  // had long become ~1 mm), its tilt down to 10 m by ICP (the ring's ~0.05 deg become ~0.02): the composite
+  // pose (EstimatorOptions). The ISS's from the
   // hand-over at 12 m to 7 m: there the ring's roll, from the reflector targets, is 0.06 deg RMS at 10-12 m
   // in the closed loop (four lidar seeds: the goal is 0.05), ICP's, on the docking adapter's asymmetric
   // features, 0.018 with a sigma under 0.03 deg; so the ISS takes ICP's roll up to that sigma. Hubble takes
@@ -102,8 +103,11 @@ void applyTargetDefaults(PoseConfig* config) {
   // petals and reflectors a few pixels wide at 15-20 m, is worse: hubble_hold's five lidar seeds, 10-20 m
   // attitude RMS 0.051-0.053 -> 0.014-0.022 deg (with the composite's flags of ICP's roll; 0.1 deg:
   // 0.025-0.031).
+  // Hubble's band ends at the hand-over, 20 m, since session 37: beyond, ICP's own port position (its
+  // contours' consensus from 25 m out) is better than the ring's (hubble_hold, lidar seeds 2 / 11, 20-30 m:
+  // 2.16 / 2.18 -> 0.80 / 0.82 mm RMS, worst frame 7.0 / 11.0 -> 2.4 / 2.3 mm).
   config->estimator.composite_min_port_range_m = hubble ? 10.0 : 7.0;
-  config->estimator.composite_max_port_range_m = hubble ? 30.0 : 12.5;
+  config->estimator.composite_max_port_range_m = hubble ? 20.0 : 12.5;
   // Since session 34 ICP's covariance takes in its roll prior (held, or fused where observed:
   // IcpOptions::boresight_prior_when_observed), so a roll averaged over a long track passes the ISS's 0.03
   // (`auto`, five lidar seeds: 7-8 m attitude RMS 0.026-0.029 -> 0.018-0.022 deg, 8-9 m 0.025-0.038 ->

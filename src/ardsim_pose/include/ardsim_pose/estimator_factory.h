@@ -40,8 +40,8 @@ struct PoseConfig {
 // position rests on the rim of its face-on aft bulkhead, whose offsets count only beyond the model's sample
 // spacing: with the ISS's 0.03 m and 1000 points the Hubble approach dataset's bands inside 30 m were 1.5-3.5
 // cm RMS, with 0.015 m and 2500 1.0-2.0 cm. Then the hand-over to the ring at 20 m and the composite pose at
-// 10-30 m (EstimatorOptions). The ISS keeps the struct's defaults. Call it after choosing the target, before
-// other overrides.
+// 10-20 m (EstimatorOptions; 10-30 m until session 37). The ISS keeps the struct's defaults. Call it after
+// choosing the target, before other overrides.
 void applyTargetDefaults(PoseConfig* config);
 
 // Throws std::invalid_argument naming the option, its value and the allowed values.

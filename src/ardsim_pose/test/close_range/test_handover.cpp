@@ -102,10 +102,11 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
 }
 
 // Hubble in auto from 28 m through the hand-over at 20 m to 18.4 m (port to port; 0.2 m a 0.1 s frame),
-// tilted, offset and rolled a little, from an acquisition at the first frame: the composite pose
-// (EstimatorOptions) takes the port position from the ring method and the tilt from ICP throughout, the
-// hand-over included. ICP alone places Hubble's port ~2 cm off there (its lateral position rests on the rim
-// of the face-on bulkhead), the ring alone tilts ~0.05 deg.
+// tilted, offset and rolled a little, from an acquisition at the first frame: ICP's pose to 20 m (its
+// lateral position from the face-on bulkhead's rim: the occluding contours, by consensus from 25 m out),
+// then the composite pose (EstimatorOptions), the port position from the ring method and the tilt from ICP
+// (the ring alone tilts ~0.05 deg). Until session 37 the composite began at 30 m: port position RMS 1.9 mm,
+// worst 4.0 mm here; since, 1.0 / 2.9 mm.
 TEST(CloseRangeHandover, HubbleCompositePortFromTheRingTiltFromIcp) {
   testing::TargetRenderer renderer(true, 13, TargetKind::kHubble);
   PoseConfig config;
@@ -126,10 +127,10 @@ TEST(CloseRangeHandover, HubbleCompositePortFromTheRingTiltFromIcp) {
     position_max_m = std::max(position_max_m, position_m);
     tilt_error.push_back(e.rotation_deg.tail<2>().norm());  // about the port's y and z: across the axis
   }
-  std::printf("Hubble 28-18.4 m, composite: port position rms %.4f m max %.4f m, tilt rms %.4f deg\n",
+  std::printf("Hubble 28-18.4 m, auto: port position rms %.4f m max %.4f m, tilt rms %.4f deg\n",
               rms(position_error), position_max_m, rms(tilt_error));
-  EXPECT_LT(rms(position_error), 0.005);
-  EXPECT_LT(position_max_m, 0.01);
+  EXPECT_LT(rms(position_error), 0.003);
+  EXPECT_LT(position_max_m, 0.006);
   EXPECT_LT(rms(tilt_error), 0.03);
 }
 
