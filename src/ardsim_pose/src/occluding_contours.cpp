@@ -445,6 +445,9 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
   }
   if (strips_.empty()) return 0;
   const double reach_m = reach_px * depth_sum / strips_.size() / f;
+  // polygon_ and its moments, of the members' strips as they are (members: how many).
+  int members = 0;
+  bool moments = false;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   if (voting) {
@@ -459,17 +462,21 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
         changed = changed || member != s.member;
         s.member = member;
       }
-      if (!changed || intersectMembers(reach_m) == 0 || !polygonMoments(&mean, &covariance)) break;
+      if (!changed) break;
+      members = intersectMembers(reach_m);
+      moments = members > 0 && polygonMoments(&mean, &covariance);
+      if (!moments) break;
       point = mean;
     }
     members_.assign(pairs_.size(), 0);
     for (const Strip& s : strips_) members_[s.pair] = s.member;
-  }
-  if (intersectMembers(reach_m) == 0) return 0;
-  if (!polygonMoments(&mean, &covariance)) {
+    if (!moments) return 0;
+  } else {
+    members = intersectMembers(reach_m);
+    if (members == 0) return 0;
     // The members' strips moved apart with the pose (their contours on other triangles): vote again.
-    if (voting) return 0;
-    return accumulateConsensus(T_lidar_target, sigma_m, reach_px, floor_px, min_information, true, H, g);
+    if (!polygonMoments(&mean, &covariance))
+      return accumulateConsensus(T_lidar_target, sigma_m, reach_px, floor_px, min_information, true, H, g);
   }
   const double floor_m = floor_px * depth_sum / strips_.size() / f;
   covariance += floor_m * floor_m * Eigen::Matrix2d::Identity();
@@ -481,8 +488,7 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
                                       eigen.eigenvectors().transpose();
   H->topLeftCorner<2, 2>() += information;
   g->head<2>() += information * mean;
-  return static_cast<int>(
-      std::count_if(strips_.begin(), strips_.end(), [](const Strip& s) { return s.member; }));
+  return members;
 }
 
 }  // namespace ardsim_pose

@@ -380,9 +380,10 @@ class IcpTracker : public PoseMethod {
   bool contours_extracted_ = false;
   int contour_generation_ = -1;  // the visibility prediction the contours' model points were chosen with
   Eigen::Isometry3d T_contours_ = Eigen::Isometry3d::Identity();  // ... and the pose
-  bool consensus_voted_ =
-      false;  // this frame, by the contours' consensus (IcpOptions::contour_consensus_min_depth_m)
-  Eigen::Isometry3d T_consensus_vote_ = Eigen::Isometry3d::Identity();  // ... at this pose
+  // Whether the contours' consensus voted this frame (IcpOptions::contour_consensus_min_depth_m), and at
+  // which pose.
+  bool consensus_voted_ = false;
+  Eigen::Isometry3d T_consensus_vote_ = Eigen::Isometry3d::Identity();
 };
 
 }  // namespace ardsim_pose
