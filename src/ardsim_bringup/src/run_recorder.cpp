@@ -265,7 +265,9 @@ int main(int argc, char** argv) {
     // Several threads: one topic's callbacks run one at a time, so a cloud being queued holds up no other
     // topic.
     ros::AsyncSpinner spinner(4);
-    spinner.start();
+    // Stopped before the first /clock (a run that could not start): nothing is taken (a message at time 0,
+    // run/outcome, would throw), and the bag is closed empty.
+    if (ros::Time::isValid()) spinner.start();
     recorder.writeUntilStopped();
   } catch (const rosbag::BagException& e) {
     ROS_FATAL("run_recorder: %s", e.what());

@@ -10,6 +10,7 @@
 // and the node stops advancing.
 #include <ardsim_msgs/ContactEvent.h>
 #include <ardsim_msgs/log_throttle.h>
+#include <ardsim_msgs/startup_error.h>
 #include <ardsim_msgs/subscriber_wait.h>
 #include <algorithm>
 #include <cmath>
@@ -307,11 +308,19 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "dynamics");
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
+  std::unique_ptr<ardsim_dynamics::Simulation> sim;
+  std::unique_ptr<ardsim_dynamics::DynamicsNode> node;
   try {
     const ardsim_dynamics::DynamicsNodeOptions options = ardsim_dynamics::loadOptions(pnh);
-    ardsim_dynamics::Simulation sim(ardsim_dynamics::loadScenario(options.scenario_path));
-    ardsim_dynamics::DynamicsNode node(nh, options, sim);
-    return node.run();
+    sim = std::make_unique<ardsim_dynamics::Simulation>(ardsim_dynamics::loadScenario(options.scenario_path));
+    node = std::make_unique<ardsim_dynamics::DynamicsNode>(nh, options, *sim);
+  } catch (const std::exception& e) {
+    ROS_FATAL("dynamics: %s", e.what());
+    ardsim_msgs::reportStartupError(nh, "dynamics", e.what());
+    return 1;
+  }
+  try {
+    return node->run();
   } catch (const std::exception& e) {
     ROS_FATAL("dynamics: %s", e.what());
     return 1;

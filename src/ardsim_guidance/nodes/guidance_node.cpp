@@ -2,6 +2,7 @@
 // stamp. Reads the chaser's own inertial state from truth/chaser/odom (standing in for its GPS, star tracker
 // and gyros); never any relative truth. Parameters: config/guidance.yaml.
 #include <ardsim_msgs/log_throttle.h>
+#include <ardsim_msgs/startup_error.h>
 #include <deque>
 #include <map>
 #include <vector>
@@ -217,6 +218,7 @@ int main(int argc, char** argv) {
     options = loadOptions(pnh, &own_state_timeout_s);
   } catch (const std::exception& e) {
     ROS_FATAL("guidance: %s", e.what());
+    ardsim_msgs::reportStartupError(nh, "guidance", e.what());
     return 1;
   }
   GuidanceNode node(nh, options, own_state_timeout_s);

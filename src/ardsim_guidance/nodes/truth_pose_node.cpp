@@ -3,6 +3,7 @@
 // and scripted LOST intervals, so guidance can be tested without the LIDAR and pose chain. One estimate per
 // stamp for which both odometries arrived.
 #include <ardsim_msgs/log_throttle.h>
+#include <ardsim_msgs/startup_error.h>
 #include <map>
 #include <vector>
 
@@ -114,6 +115,7 @@ int main(int argc, char** argv) {
     options = loadOptions(pnh, &target);
   } catch (const std::exception& e) {
     ROS_FATAL("truth_pose: %s", e.what());
+    ardsim_msgs::reportStartupError(nh, "truth_pose", e.what());
     return 1;
   }
   ROS_INFO("truth_pose: TEST TOOL publishing pose/estimate from truth (never use in a real run)");

@@ -1,5 +1,8 @@
 // The pose estimator as a plain node (same interface as the nodelet). A bad parameter stops it at start with
 // one line naming the parameter, and exit status 2.
+#include <memory>
+
+#include <ardsim_msgs/startup_error.h>
 #include <ros/ros.h>
 
 #include "pose_driver.h"
@@ -8,8 +11,15 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "pose");
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
+  std::unique_ptr<ardsim_pose::PoseDriver> driver;
   try {
-    ardsim_pose::PoseDriver driver(nh, private_nh);
+    driver = std::make_unique<ardsim_pose::PoseDriver>(nh, private_nh);
+  } catch (const std::exception& e) {
+    ROS_FATAL("pose: %s", e.what());
+    ardsim_msgs::reportStartupError(nh, "pose", e.what());
+    return 2;
+  }
+  try {
     ros::spin();
   } catch (const std::exception& e) {
     ROS_FATAL("pose: %s", e.what());

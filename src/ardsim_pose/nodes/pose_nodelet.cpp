@@ -2,6 +2,7 @@
 // by pointer.
 #include <memory>
 
+#include <ardsim_msgs/startup_error.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
@@ -16,6 +17,7 @@ class PoseNodelet : public nodelet::Nodelet {
       driver_ = std::make_unique<PoseDriver>(getNodeHandle(), getPrivateNodeHandle());
     } catch (const std::exception& e) {
       NODELET_FATAL("%s", e.what());
+      ardsim_msgs::reportStartupError(getNodeHandle(), getName(), e.what());
       throw;
     }
   }
