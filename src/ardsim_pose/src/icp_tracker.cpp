@@ -8,6 +8,7 @@
 #include <string>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
 #include "require_option.h"
 #include "tukey_weight.h"
@@ -134,6 +135,8 @@ void validate(const IcpOptions& o) {
                 "icp/contour_max_depth_m", o.contour_max_depth_m, ">= 0");
   requireOption(!std::isnan(o.contour_consensus_min_depth_m) && o.contour_consensus_min_depth_m >= 0.0,
                 "icp/contour_consensus_min_depth_m", o.contour_consensus_min_depth_m, ">= 0 (inf: never)");
+  requireOption(o.lateral_history_frames >= 0 && o.lateral_history_frames <= 1000,
+                "icp/lateral_history_frames", o.lateral_history_frames, "0 .. 1000");
   requireOption(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
   requireOption(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
@@ -398,11 +401,56 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
     const bool vote = !consensus_voted_ ||
                       imageMotionPx(T_consensus_vote_, a.T, visibility().nearestDepth()) > kConsensusRevotePx;
     if (vote) consensus_voted_ = true, T_consensus_vote_ = a.T;
-    return contours_.accumulateConsensus(a.T, a.limit_m / options_.tukey_c, kConsensusReachPx,
-                                         kConsensusFloorPx, min_information, vote, H, g) > 0;
+    const double sigma_m = a.limit_m / options_.tukey_c;
+    if (contours_.accumulateConsensus(a.T, sigma_m, kConsensusReachPx, kConsensusFloorPx, min_information,
+                                      vote, H, g) == 0)
+      return false;
+    // This frame's own measurement (IcpOptions::lateral_history_frames), of the point the history follows:
+    // the consensus's translation moves every point alike.
+    if (lateral_history_.empty() && !lateral_measured_) lateral_reference_target_ = a.T.inverse() * a.centre;
+    lateral_measured_ = true;
+    const Eigen::Vector2d reference_m = (a.T * lateral_reference_target_).head<2>();
+    lateral_this_frame_ = {cloud_->stamp_s, reference_m + contours_.consensusMean(),
+                           contours_.consensusCovariance()};
+    Eigen::Vector2d prior_m;
+    Eigen::Matrix2d prior_covariance_m2;
+    if (lateralPrior(cloud_->stamp_s, &prior_m, &prior_covariance_m2)) {
+      const Eigen::Vector2d disagreement = lateral_this_frame_.position_m - prior_m;
+      const Eigen::Matrix2d combined = prior_covariance_m2 + lateral_this_frame_.covariance_m2;
+      if (disagreement.dot(combined.ldlt().solve(disagreement)) < 9.0) {  // within 3 sigma
+        const Eigen::Matrix2d information = (sigma_m * sigma_m) * prior_covariance_m2.inverse();
+        H->topLeftCorner<2, 2>() += information;
+        g->head<2>() += information * (prior_m - reference_m);
+      }
+    }
+    return true;
   }
   return contours_.accumulate(with_boresight_rotation, a.T, a.centre, a.limit_m / options_.tukey_c,
                               options_.contour_sigma_px, kContourWindowPx, H, g) > 0;
+}
+
+bool IcpTracker::lateralPrior(double stamp_s, Eigen::Vector2d* position_m,
+                              Eigen::Matrix2d* covariance_m2) const {
+  if (lateral_history_.size() < 3) return false;
+  // position(t) = p + (t - stamp_s) v, weighted by each measurement's information.
+  Eigen::Matrix4d N = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d b = Eigen::Vector4d::Zero();
+  for (const LateralMeasurement& m : lateral_history_) {
+    const double dt = m.stamp_s - stamp_s;
+    const Eigen::Matrix2d W = m.covariance_m2.inverse();
+    N.topLeftCorner<2, 2>() += W;
+    N.topRightCorner<2, 2>() += dt * W;
+    N.bottomLeftCorner<2, 2>() += dt * W;
+    N.bottomRightCorner<2, 2>() += dt * dt * W;
+    b.head<2>() += W * m.position_m;
+    b.tail<2>() += dt * W * m.position_m;
+  }
+  const Eigen::FullPivLU<Eigen::Matrix4d> lu(N);
+  if (!lu.isInvertible()) return false;
+  const Eigen::Matrix4d covariance = lu.inverse();
+  *position_m = (covariance * b).head<2>();
+  *covariance_m2 = covariance.topLeftCorner<2, 2>();
+  return position_m->allFinite() && covariance_m2->allFinite();
 }
 
 double IcpTracker::weakestOfFive(const Eigen::Matrix<double, 6, 6>& H_scaled) const {
@@ -994,6 +1042,7 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
   auto lost = [&](const std::string& reason) {
     tracked_frames_ = 0;
     tracked_.clear();
+    lateral_history_.clear();
     result.status = EstimateStatus::kLost;
     result.reason = reason;
     result.covariance.setZero();
@@ -1067,6 +1116,7 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
   cloud_ = &cloud;
   contours_extracted_ = false;
   consensus_voted_ = false;
+  lateral_measured_ = false;
   *aligned = true;
   const Alignment a =
       acquiring ? acquire(T_predicted)
@@ -1198,6 +1248,13 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
     if (tracked_.size() > 2) tracked_.erase(tracked_.begin());
   } else {
     tracked_.clear();
+  }
+  if (!acquiring && degraded.empty() && lateral_measured_ && options_.lateral_history_frames > 0) {
+    lateral_history_.push_back(lateral_this_frame_);
+    if (static_cast<int>(lateral_history_.size()) > options_.lateral_history_frames)
+      lateral_history_.erase(lateral_history_.begin());
+  } else {
+    lateral_history_.clear();
   }
   if (degraded.empty()) {
     result.status = EstimateStatus::kTracking;

@@ -480,6 +480,8 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
   }
   const double floor_m = floor_px * depth_sum / strips_.size() / f;
   covariance += floor_m * floor_m * Eigen::Matrix2d::Identity();
+  consensus_mean_m_ = mean;
+  consensus_covariance_m2_ = covariance;
   // No weaker than min_information in any direction: the caller's limit below which the directions count as
   // unobserved and the planes' coarser means take over.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen((sigma_m * sigma_m) * covariance.inverse());

@@ -63,6 +63,10 @@ class OccludingContours {
   int accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m, double reach_px,
                           double floor_px, double min_information, bool vote_again,
                           Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
+  // Of the last accumulateConsensus that added something: the lateral translation (lidar x, y, m) from its
+  // pose to the polygon's centroid and its covariance (m^2, the floor's included, before min_information).
+  const Eigen::Vector2d& consensusMean() const { return consensus_mean_m_; }
+  const Eigen::Matrix2d& consensusCovariance() const { return consensus_covariance_m2_; }
 
  private:
   struct Pair {
@@ -130,6 +134,8 @@ class OccludingContours {
   std::vector<std::uint8_t> members_;               // per pair, in the frame's consensus (empty: none yet)
   std::vector<int> votes_;                          // scratch: its vote, a difference array by rows
   std::vector<Eigen::Vector2d> polygon_, clipped_;  // scratch: its intersection
+  Eigen::Vector2d consensus_mean_m_ = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d consensus_covariance_m2_ = Eigen::Matrix2d::Identity();
 };
 
 }  // namespace ardsim_pose
