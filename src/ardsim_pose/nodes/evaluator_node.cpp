@@ -2,7 +2,6 @@
 // Truth T_lidar_target comes from truth/target/odom and truth/chaser/odom (paired by exact stamp) with
 // T_chaser_lidar. Either side may arrive first: both wait in bounded buffers keyed by stamp. Evaluation only.
 #include <map>
-#include <memory>
 #include <string>
 
 #include <ardsim_msgs/log_throttle.h>
@@ -110,19 +109,5 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "pose_evaluator");
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
-  std::unique_ptr<ardsim_pose::PoseEvaluator> evaluator;
-  try {
-    evaluator = std::make_unique<ardsim_pose::PoseEvaluator>(nh, private_nh);
-  } catch (const std::exception& e) {
-    ROS_FATAL("pose_evaluator: %s", e.what());
-    ardsim_msgs::reportStartupError(nh, "pose_evaluator", e.what());
-    return 2;
-  }
-  try {
-    ros::spin();
-  } catch (const std::exception& e) {
-    ROS_FATAL("pose_evaluator: %s", e.what());
-    return 2;
-  }
-  return 0;
+  return ardsim_msgs::spinNode<ardsim_pose::PoseEvaluator>("pose_evaluator", nh, private_nh);
 }

@@ -1,7 +1,5 @@
 // The pose estimator as a plain node (same interface as the nodelet). A bad parameter stops it at start with
 // one line naming the parameter, and exit status 2.
-#include <memory>
-
 #include <ardsim_msgs/startup_error.h>
 #include <ros/ros.h>
 
@@ -11,19 +9,5 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "pose");
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
-  std::unique_ptr<ardsim_pose::PoseDriver> driver;
-  try {
-    driver = std::make_unique<ardsim_pose::PoseDriver>(nh, private_nh);
-  } catch (const std::exception& e) {
-    ROS_FATAL("pose: %s", e.what());
-    ardsim_msgs::reportStartupError(nh, "pose", e.what());
-    return 2;
-  }
-  try {
-    ros::spin();
-  } catch (const std::exception& e) {
-    ROS_FATAL("pose: %s", e.what());
-    return 2;
-  }
-  return 0;
+  return ardsim_msgs::spinNode<ardsim_pose::PoseDriver>("pose", nh, private_nh);
 }

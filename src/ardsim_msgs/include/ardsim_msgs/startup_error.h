@@ -4,9 +4,12 @@
 // would wait forever instead of ending with the parameter named.
 #pragma once
 
+#include <exception>
+#include <memory>
 #include <string>
 
 #include <ros/node_handle.h>
+#include <ros/ros.h>
 
 namespace ardsim_msgs {
 
@@ -19,6 +22,27 @@ inline void reportStartupError(const ros::NodeHandle& nh, const std::string& nod
   std::string earlier;
   if (nh.getParam(kStartupErrorParam, earlier) && !earlier.empty()) return;
   nh.setParam(kStartupErrorParam, node + ": " + what);
+}
+
+// A plain node's main: Driver(nh, private_nh) set up, then spun. A failure to start is logged, reported as
+// above and answered with exit status 2; an exception out of the spin is logged, exit status 2 as well.
+template <typename Driver>
+int spinNode(const char* node, const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
+  std::unique_ptr<Driver> driver;
+  try {
+    driver = std::make_unique<Driver>(nh, private_nh);
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", node, e.what());
+    reportStartupError(nh, node, e.what());
+    return 2;
+  }
+  try {
+    ros::spin();
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", node, e.what());
+    return 2;
+  }
+  return 0;
 }
 
 }  // namespace ardsim_msgs
