@@ -87,10 +87,10 @@ struct IcpOptions {
   // lateral_history_frames tracking frames in a row: the straight line through them (each weighted by its
   // polygon's covariance) at the frame's stamp, with that fit's covariance, where the frame's own measurement
   // lies within 3 sigma of it (a manoeuvre the line does not follow is not followed). A frame's pixels place
-  // the rim to ~1 mm at 30-50 m, the line through ten
-  // frames to ~0.6 (hubble_hold, lidar seeds 2-51: ICP 30-50 m port position RMS 0.96-1.02 -> 0.63-0.66 mm).
-  // Longer lines lag: in the closed loop the chaser's attitude control swings the target across the lidar
-  // frame by millimetres in a second (20 frames: 25-30 m biased 0.8-0.95 mm). 0: none.
+  // Hubble's rim to ~1 mm at 30-50 m, the line through ten frames to ~0.6 (hubble_hold, five lidar seeds:
+  // ICP 30-50 m port position RMS 0.96-1.02 -> 0.62-0.66 mm). Longer lines lag: in the closed loop the
+  // chaser's attitude control swings the target across the lidar frame by millimetres in a second (20
+  // frames: 25-30 m biased 0.8-0.95 mm). 0: none.
   int lateral_history_frames = 10;
   double min_sigma_m = 0.01;  // floor of the robust sigma (the sensor's range noise)
   // Tracking: the rotation about the boresight is held near the prediction with this standard deviation
