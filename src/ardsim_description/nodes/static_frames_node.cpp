@@ -1,5 +1,6 @@
 // static_frames: publishes the description's fixed frames on /tf_static (target -> target_port,
 // chaser -> chaser_port, chaser -> lidar_optical) and, latched, the vehicle meshes for rviz. See README.md.
+#include <ardsim_msgs/startup_error.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
     options = loadStaticFramesOptions(private_nh);
   } catch (const std::invalid_argument& e) {
     ROS_FATAL("static_frames: %s", e.what());
+    ardsim_msgs::reportStartupError(nh, "static_frames", e.what());
     return 1;
   }
 
