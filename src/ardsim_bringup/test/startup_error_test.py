@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A bad value in a scenario's node section ends the run with outcome error, the node and the parameter named, and
 run_scenario's exit status 1: the pose nodelet (respawned by docking.launch, so it fails in a loop), the pose and
-lidar as plain nodes (use_nodelets:=false), guidance. Before ardsim_msgs/startup_error.h the run waited for the
+lidar as plain nodes (use_nodelets:=false), guidance, and a target no node knows. Before ardsim_msgs/startup_error.h the run waited for the
 failed node forever (the dynamics waits for every subscriber before its first step). The bag is closed, empty."""
 import json
 import os
@@ -22,6 +22,8 @@ CASES = [  # (name, section, {key: bad value}, run_scenario args, what the reaso
     ("lidar_node", "lidar", {"noise": {"dead_pixel_fraction": 1.5}}, ["use_nodelets:=false"],
      ["lidar", "dead_pixel_fraction", "1.5"]),
     ("guidance", "guidance", {"approach": {"damping_ratio": -1.0}}, [], ["guidance", "approach/damping_ratio"]),
+    # Every node reads the target: whichever refuses it first (static_frames here) names it.
+    ("target", "target", {"kind": "foo"}, [], ["target", "foo"]),
 ]
 
 
