@@ -393,6 +393,7 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
     contour_generation_ = visibility_generation_;
     T_contours_ = a.T;
   }
+  const double sigma_m = a.limit_m / options_.tukey_c;
   if (!with_boresight_rotation && visibility().nearestDepth() >= options_.contour_consensus_min_depth_m) {
     // The vote again after the pose moved a quarter pixel (the members chosen there may not hold at the new
     // pose: from an approach dataset's predictions 0.5 m off in range, two of 24 runs slid 1-2 cm off), else
@@ -401,22 +402,21 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
     const bool vote = !consensus_voted_ ||
                       imageMotionPx(T_consensus_vote_, a.T, visibility().nearestDepth()) > kConsensusRevotePx;
     if (vote) consensus_voted_ = true, T_consensus_vote_ = a.T;
-    const double sigma_m = a.limit_m / options_.tukey_c;
     if (contours_.accumulateConsensus(a.T, sigma_m, kConsensusReachPx, kConsensusFloorPx, min_information,
                                       vote, H, g) == 0)
       return false;
     // This frame's own measurement (IcpOptions::lateral_history_frames), of the point the history follows:
     // the consensus's translation moves every point alike.
-    if (lateral_history_.empty() && !lateral_measured_) lateral_reference_target_ = a.T.inverse() * a.centre;
-    lateral_measured_ = true;
+    if (lateral_history_.empty() && !lateral_this_frame_)
+      lateral_reference_target_ = a.T.inverse() * a.centre;
     const Eigen::Vector2d reference_m = (a.T * lateral_reference_target_).head<2>();
-    lateral_this_frame_ = {cloud_->stamp_s, reference_m + contours_.consensusMean(),
-                           contours_.consensusCovariance()};
+    lateral_this_frame_ = LateralMeasurement{cloud_->stamp_s, reference_m + contours_.consensusMean(),
+                                             contours_.consensusCovariance()};
     Eigen::Vector2d prior_m;
     Eigen::Matrix2d prior_covariance_m2;
     if (lateralPrior(cloud_->stamp_s, &prior_m, &prior_covariance_m2)) {
-      const Eigen::Vector2d disagreement = lateral_this_frame_.position_m - prior_m;
-      const Eigen::Matrix2d combined = prior_covariance_m2 + lateral_this_frame_.covariance_m2;
+      const Eigen::Vector2d disagreement = lateral_this_frame_->position_m - prior_m;
+      const Eigen::Matrix2d combined = prior_covariance_m2 + lateral_this_frame_->covariance_m2;
       if (disagreement.dot(combined.ldlt().solve(disagreement)) < 9.0) {  // within 3 sigma
         const Eigen::Matrix2d information = (sigma_m * sigma_m) * prior_covariance_m2.inverse();
         H->topLeftCorner<2, 2>() += information;
@@ -425,8 +425,8 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
     }
     return true;
   }
-  return contours_.accumulate(with_boresight_rotation, a.T, a.centre, a.limit_m / options_.tukey_c,
-                              options_.contour_sigma_px, kContourWindowPx, H, g) > 0;
+  return contours_.accumulate(with_boresight_rotation, a.T, a.centre, sigma_m, options_.contour_sigma_px,
+                              kContourWindowPx, H, g) > 0;
 }
 
 bool IcpTracker::lateralPrior(double stamp_s, Eigen::Vector2d* position_m,
@@ -1116,7 +1116,7 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
   cloud_ = &cloud;
   contours_extracted_ = false;
   consensus_voted_ = false;
-  lateral_measured_ = false;
+  lateral_this_frame_.reset();
   *aligned = true;
   const Alignment a =
       acquiring ? acquire(T_predicted)
@@ -1249,8 +1249,8 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
   } else {
     tracked_.clear();
   }
-  if (!acquiring && degraded.empty() && lateral_measured_ && options_.lateral_history_frames > 0) {
-    lateral_history_.push_back(lateral_this_frame_);
+  if (!acquiring && degraded.empty() && lateral_this_frame_ && options_.lateral_history_frames > 0) {
+    lateral_history_.push_back(*lateral_this_frame_);
     if (static_cast<int>(lateral_history_.size()) > options_.lateral_history_frames)
       lateral_history_.erase(lateral_history_.begin());
   } else {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -404,8 +405,7 @@ class IcpTracker : public PoseMethod {
   };
   std::vector<LateralMeasurement> lateral_history_;
   Eigen::Vector3d lateral_reference_target_ = Eigen::Vector3d::Zero();  // the point measured, target frame
-  bool lateral_measured_ = false;                                       // this frame, by its last consensus
-  LateralMeasurement lateral_this_frame_{};
+  std::optional<LateralMeasurement> lateral_this_frame_;  // by its last consensus (none: no consensus)
   // The history's weighted straight line at stamp_s: the position and its covariance (false: fewer than
   // three measurements, or no spread in time).
   bool lateralPrior(double stamp_s, Eigen::Vector2d* position_m, Eigen::Matrix2d* covariance_m2) const;
