@@ -137,6 +137,8 @@ void validate(const IcpOptions& o) {
                 "icp/contour_consensus_min_depth_m", o.contour_consensus_min_depth_m, ">= 0 (inf: never)");
   requireOption(o.lateral_history_frames >= 0 && o.lateral_history_frames <= 1000,
                 "icp/lateral_history_frames", o.lateral_history_frames, "0 .. 1000");
+  requireOption(o.lateral_vote_weight >= 0.0 && o.lateral_vote_weight <= 100.0, "icp/lateral_vote_weight",
+                o.lateral_vote_weight, "0 .. 100");
   requireOption(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
   requireOption(
       std::isfinite(o.boresight_prior_deg) && o.boresight_prior_deg >= 0.0 && o.boresight_prior_deg <= 180.0,
@@ -402,19 +404,23 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
     const bool vote = !consensus_voted_ ||
                       imageMotionPx(T_consensus_vote_, a.T, visibility().nearestDepth()) > kConsensusRevotePx;
     if (vote) consensus_voted_ = true, T_consensus_vote_ = a.T;
-    if (contours_.accumulateConsensus(a.T, sigma_m, kConsensusReachPx, kConsensusFloorPx, min_information,
-                                      vote, H, g) == 0)
-      return false;
-    // This frame's own measurement (IcpOptions::lateral_history_frames), of the point the history follows:
-    // the consensus's translation moves every point alike.
+    // The line through the history (IcpOptions::lateral_history_frames), of the point it follows: the
+    // consensus's translation moves every point alike.
     if (lateral_history_.empty() && !lateral_this_frame_)
       lateral_reference_target_ = a.T.inverse() * a.centre;
     const Eigen::Vector2d reference_m = (a.T * lateral_reference_target_).head<2>();
-    lateral_this_frame_ = LateralMeasurement{cloud_->stamp_s, reference_m + contours_.consensusMean(),
-                                             contours_.consensusCovariance()};
     Eigen::Vector2d prior_m;
     Eigen::Matrix2d prior_covariance_m2;
-    if (lateralPrior(cloud_->stamp_s, &prior_m, &prior_covariance_m2)) {
+    const bool prior = lateralPrior(cloud_->stamp_s, &prior_m, &prior_covariance_m2);
+    OccludingContours::VotePrior vote_prior;
+    if (prior) vote_prior = {prior_m - reference_m, prior_covariance_m2, options_.lateral_vote_weight};
+    if (contours_.accumulateConsensus(a.T, sigma_m, kConsensusReachPx, kConsensusFloorPx, min_information,
+                                      vote, H, g, prior ? &vote_prior : nullptr) == 0)
+      return false;
+    // This frame's own measurement, for the history.
+    lateral_this_frame_ = LateralMeasurement{cloud_->stamp_s, reference_m + contours_.consensusMean(),
+                                             contours_.consensusCovariance()};
+    if (prior) {
       const Eigen::Vector2d disagreement = lateral_this_frame_->position_m - prior_m;
       const Eigen::Matrix2d combined = prior_covariance_m2 + lateral_this_frame_->covariance_m2;
       if (disagreement.dot(combined.ldlt().solve(disagreement)) < 9.0) {  // within 3 sigma

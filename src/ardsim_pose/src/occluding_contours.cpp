@@ -58,6 +58,7 @@ void OccludingContours::extract(const OrganizedCloud& cloud, const std::vector<i
   }
   pairs_.clear();
   members_.clear();
+  votes_this_frame_ = 0;
   column_has_pair_.assign(w, 0);
   row_has_pair_.assign(h, 0);
   // The model's contour is looked for window_px either side of the pair, inside the image.
@@ -337,9 +338,9 @@ void clipPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vecto
 }
 }  // namespace
 
-Eigen::Vector2d OccludingContours::vote(double reach_m) {
+Eigen::Vector2d OccludingContours::vote(double reach_m, const VotePrior* prior) {
   // Each strip |offset + a . d| <= 1/2 over a grid of translations d within reach_m, by rows of a difference
-  // array; the winner has the most votes, the nearest the pose among equals.
+  // array; the winner has the most votes (less the prior's penalty), the nearest the pose among equals.
   constexpr int kHalfCells = 40, kCells = 2 * kHalfCells + 1;
   const double cell_m = reach_m / kHalfCells;
   const double row0_dy = -kHalfCells * cell_m;
@@ -367,14 +368,26 @@ Eigen::Vector2d OccludingContours::vote(double reach_m) {
       --votes_[j * (kCells + 1) + i1 + 1];
     }
   }
-  // The winner: the most votes, nearest the pose among equals.
-  int best = 0, best_i = kHalfCells, best_j = kHalfCells, best_r2 = 0;
+  const bool weighed = prior != nullptr && prior->weight > 0.0 && ++votes_this_frame_ <= kMaxVotesWithPrior;
+  const Eigen::Matrix2d W =
+      weighed ? Eigen::Matrix2d(0.5 * prior->weight *
+                                (prior->covariance_m2 + cell_m * cell_m * Eigen::Matrix2d::Identity()).inverse())
+              : Eigen::Matrix2d::Zero();
+  // The winner: the best score, nearest the pose among equals.
+  double best = -std::numeric_limits<double>::infinity();
+  int best_i = kHalfCells, best_j = kHalfCells, best_r2 = 0;
   for (int j = 0; j < kCells; ++j) {
     int count = 0;
     for (int i = 0; i < kCells; ++i) {
       count += votes_[j * (kCells + 1) + i];
+      double score = count;
+      if (weighed) {
+        const Eigen::Vector2d off =
+            Eigen::Vector2d((i - kHalfCells) * cell_m, (j - kHalfCells) * cell_m) - prior->translation_m;
+        score -= off.dot(W * off);
+      }
       const int r2 = (i - kHalfCells) * (i - kHalfCells) + (j - kHalfCells) * (j - kHalfCells);
-      if (count > best || (count == best && r2 < best_r2)) best = count, best_i = i, best_j = j, best_r2 = r2;
+      if (score > best || (score == best && r2 < best_r2)) best = score, best_i = i, best_j = j, best_r2 = r2;
     }
   }
   return Eigen::Vector2d((best_i - kHalfCells) * cell_m, (best_j - kHalfCells) * cell_m);
@@ -416,7 +429,7 @@ bool OccludingContours::polygonMoments(Eigen::Vector2d* mean, Eigen::Matrix2d* c
 int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m,
                                            double reach_px, double floor_px, double min_information,
                                            bool vote_again, Eigen::Matrix<double, 6, 6>* H,
-                                           Eigen::Matrix<double, 6, 1>* g) {
+                                           Eigen::Matrix<double, 6, 1>* g, const VotePrior* prior) {
   if (pairs_.empty() || candidates_.empty()) return 0;
   if (vote_again) members_.clear();
   project(T_lidar_target);
@@ -454,7 +467,7 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
     // The vote once a frame, its winner (a cell's centre) refined: the members are the strips that hold the
     // centroid of their own intersection, until they stay the same. Later calls intersect the same pairs'
     // strips unless told to vote again.
-    Eigen::Vector2d point = vote(reach_m);
+    Eigen::Vector2d point = vote(reach_m, prior);
     for (int round = 0; round < 5; ++round) {
       bool changed = false;
       for (Strip& s : strips_) {
@@ -476,7 +489,8 @@ int OccludingContours::accumulateConsensus(const Eigen::Isometry3d& T_lidar_targ
     if (members == 0) return 0;
     // The members' strips moved apart with the pose (their contours on other triangles): vote again.
     if (!polygonMoments(&mean, &covariance))
-      return accumulateConsensus(T_lidar_target, sigma_m, reach_px, floor_px, min_information, true, H, g);
+      return accumulateConsensus(T_lidar_target, sigma_m, reach_px, floor_px, min_information, true, H, g,
+                                 prior);
   }
   const double floor_m = floor_px * depth_sum / strips_.size() / f;
   covariance += floor_m * floor_m * Eigen::Matrix2d::Identity();

@@ -60,9 +60,21 @@ class OccludingContours {
   // (v_x, v_y), with its covariance (of a uniform distribution over it) widened by floor_px, in the units of
   // sigma_m, and no less information than min_information in any direction. Returns the members intersected
   // (0: nothing added).
+  // A prediction of the lateral translation (from the pose, lidar x, y, m; its covariance, m^2) that the
+  // vote weighs against the strips' counts: a translation d scores its votes less weight / 2 times
+  // (d - translation)^T (covariance + cell^2)^-1 (d - translation). Only in the frame's first
+  // kMaxVotesWithPrior votes: where the members' strips move apart between two poses (and so vote again), a
+  // pull at every vote swung the pose between two plateaus (an approach dataset's frame to the iteration
+  // limit).
+  struct VotePrior {
+    Eigen::Vector2d translation_m = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d covariance_m2 = Eigen::Matrix2d::Identity();
+    double weight = 0.0;
+  };
   int accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m, double reach_px,
                           double floor_px, double min_information, bool vote_again,
-                          Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
+                          Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g,
+                          const VotePrior* prior = nullptr);
   // Of the last accumulateConsensus that added something: the lateral translation (lidar x, y, m) from its
   // pose to the polygon's centroid and its covariance (m^2, the floor's included, before min_information).
   const Eigen::Vector2d& consensusMean() const { return consensus_mean_m_; }
@@ -124,8 +136,10 @@ class OccludingContours {
     std::size_t pair;  // its index in pairs_
     bool member = false;
   };
-  // The translation within reach_m of the pose that the most strips_ hold.
-  Eigen::Vector2d vote(double reach_m);
+  // The translation within reach_m of the pose that the most strips_ hold (weighed against prior, if any).
+  Eigen::Vector2d vote(double reach_m, const VotePrior* prior);
+  static constexpr int kMaxVotesWithPrior = 4;
+  int votes_this_frame_ = 0;
   // polygon_: the intersection of the member strips within reach_m; returns their number.
   int intersectMembers(double reach_m);
   // The mean and covariance of a uniform distribution over polygon_ (false: no area).
