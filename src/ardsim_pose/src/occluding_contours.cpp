@@ -370,9 +370,10 @@ Eigen::Vector2d OccludingContours::vote(double reach_m, const VotePrior* prior) 
   }
   const bool weighed = prior != nullptr && prior->weight > 0.0 && ++votes_this_frame_ <= kMaxVotesWithPrior;
   const Eigen::Matrix2d W =
-      weighed ? Eigen::Matrix2d(0.5 * prior->weight *
-                                (prior->covariance_m2 + cell_m * cell_m * Eigen::Matrix2d::Identity()).inverse())
-              : Eigen::Matrix2d::Zero();
+      weighed
+          ? Eigen::Matrix2d(0.5 * prior->weight *
+                            (prior->covariance_m2 + cell_m * cell_m * Eigen::Matrix2d::Identity()).inverse())
+          : Eigen::Matrix2d::Zero();
   // The winner: the best score, nearest the pose among equals.
   double best = -std::numeric_limits<double>::infinity();
   int best_i = kHalfCells, best_j = kHalfCells, best_r2 = 0;

@@ -803,8 +803,8 @@ TEST(HubbleHold, LateralHistoryPlacesTheRimBetterThanEachFrameAlone) {
   ASSERT_GT(hubbleDefaults().icp.lateral_history_frames, 0);
   const PortError with = hubbleLateralError(hubbleDefaults().icp.lateral_history_frames, 0.0);
   const PortError without = hubbleLateralError(0, 0.0);
-  std::printf("port position RMS with the lateral history %.2f mm, each frame alone %.2f mm\n", with.rms_m * 1e3,
-              without.rms_m * 1e3);
+  std::printf("port position RMS with the lateral history %.2f mm, each frame alone %.2f mm\n",
+              with.rms_m * 1e3, without.rms_m * 1e3);
   EXPECT_LT(with.rms_m, 0.8 * without.rms_m);  // measured 0.63 vs 0.85 mm
 }
 
@@ -819,10 +819,12 @@ TEST(HubbleHold, LateralLineInTheVoteCutsTheWorstFrames) {
     const PortError weighed =
         hubbleLateralError(defaults.lateral_history_frames, defaults.lateral_vote_weight, seed);
     const PortError counted = hubbleLateralError(defaults.lateral_history_frames, 0.0, seed);
-    std::printf("seed %d: port position RMS / worst frame with the line in the vote %.2f / %.2f mm, the strips "
-                "alone %.2f / %.2f mm\n",
-                seed, weighed.rms_m * 1e3, weighed.worst_m * 1e3, counted.rms_m * 1e3, counted.worst_m * 1e3);
-    EXPECT_LT(weighed.worst_m, 3.0 * weighed.rms_m) << "seed " << seed;  // measured 2.21-2.91x (alone 2.29-6.37x)
+    std::printf(
+        "seed %d: port position RMS / worst frame with the line in the vote %.2f / %.2f mm, the strips "
+        "alone %.2f / %.2f mm\n",
+        seed, weighed.rms_m * 1e3, weighed.worst_m * 1e3, counted.rms_m * 1e3, counted.worst_m * 1e3);
+    EXPECT_LT(weighed.worst_m, 3.0 * weighed.rms_m)
+        << "seed " << seed;  // measured 2.21-2.91x (alone 2.29-6.37x)
     weighed_worst_m = std::max(weighed_worst_m, weighed.worst_m);
     counted_worst_m = std::max(counted_worst_m, counted.worst_m);
     weighed_rms_sum_m += weighed.rms_m;
