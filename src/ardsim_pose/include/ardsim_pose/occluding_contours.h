@@ -50,16 +50,6 @@ class OccludingContours {
                  const Eigen::Vector3d& centre, double sigma_m, double sigma_px, double limit_px,
                  Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
 
-  // The lateral translation (lidar x, y) alone, as the set of translations that put the model's contour of
-  // every pair between its two pixel centres: the midpoints above share a sub-pixel phase along a straight
-  // edge, and their mean is off by up to half a pixel with the target's position across the pixels (Hubble's
-  // bulkhead rim at 45 m: lateral error periodic in the image position, swinging 7 mm). The pairs vote over
-  // translations within reach_px (a strip each) at the frame's first call and when vote_again; the strips
-  // holding the winner (a bad pair, a dropout beside the edge, is outvoted) are its members until the next
-  // vote, intersected exactly at each call; the polygon's centroid is added to (H, g) as a measurement of
-  // (v_x, v_y), with its covariance (of a uniform distribution over it) widened by floor_px, in the units of
-  // sigma_m, and no less information than min_information in any direction. Returns the members intersected
-  // (0: nothing added).
   // A prediction of the lateral translation (from the pose, lidar x, y, m; its covariance, m^2) that the
   // vote weighs against the strips' counts: a translation d scores its votes less weight / 2 times
   // (d - translation)^T (covariance + cell^2)^-1 (d - translation). Only in the frame's first
@@ -71,6 +61,16 @@ class OccludingContours {
     Eigen::Matrix2d covariance_m2 = Eigen::Matrix2d::Identity();
     double weight = 0.0;
   };
+  // The lateral translation (lidar x, y) alone, as the set of translations that put the model's contour of
+  // every pair between its two pixel centres: the midpoints above share a sub-pixel phase along a straight
+  // edge, and their mean is off by up to half a pixel with the target's position across the pixels (Hubble's
+  // bulkhead rim at 45 m: lateral error periodic in the image position, swinging 7 mm). The pairs vote over
+  // translations within reach_px (a strip each) at the frame's first call and when vote_again; the strips
+  // holding the winner (a bad pair, a dropout beside the edge, is outvoted) are its members until the next
+  // vote, intersected exactly at each call; the polygon's centroid is added to (H, g) as a measurement of
+  // (v_x, v_y), with its covariance (of a uniform distribution over it) widened by floor_px, in the units of
+  // sigma_m, and no less information than min_information in any direction; with prior, the vote weighs it
+  // (VotePrior above). Returns the members intersected (0: nothing added).
   int accumulateConsensus(const Eigen::Isometry3d& T_lidar_target, double sigma_m, double reach_px,
                           double floor_px, double min_information, bool vote_again,
                           Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g,
