@@ -137,6 +137,8 @@ void validate(const IcpOptions& o) {
                 "icp/contour_consensus_min_depth_m", o.contour_consensus_min_depth_m, ">= 0 (inf: never)");
   requireOption(o.lateral_history_frames >= 0 && o.lateral_history_frames <= 1000,
                 "icp/lateral_history_frames", o.lateral_history_frames, "0 .. 1000");
+  requireOption(o.lateral_gate_frames >= 1 && o.lateral_gate_frames <= 1000, "icp/lateral_gate_frames",
+                o.lateral_gate_frames, "1 .. 1000");
   requireOption(o.lateral_vote_weight >= 0.0 && o.lateral_vote_weight <= 100.0, "icp/lateral_vote_weight",
                 o.lateral_vote_weight, "0 .. 100");
   requireOption(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
@@ -420,10 +422,14 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
     // This frame's own measurement, for the history.
     lateral_this_frame_ = LateralMeasurement{cloud_->stamp_s, reference_m + contours_.consensusMean(),
                                              contours_.consensusCovariance()};
+    lateral_beyond_this_frame_ = false;
     if (prior) {
       const Eigen::Vector2d disagreement = lateral_this_frame_->position_m - prior_m;
       const Eigen::Matrix2d combined = prior_covariance_m2 + lateral_this_frame_->covariance_m2;
-      if (disagreement.dot(combined.ldlt().solve(disagreement)) < 9.0) {  // within 3 sigma
+      lateral_beyond_this_frame_ = disagreement.dot(combined.ldlt().solve(disagreement)) >= 9.0;  // 3 sigma
+      // Beyond it, the line still counts in a first frame (IcpOptions::lateral_gate_frames): there it was the
+      // vote that went wrong, not the path.
+      if (!lateral_beyond_this_frame_ || lateral_disagreeing_frames_ + 1 < options_.lateral_gate_frames) {
         const Eigen::Matrix2d information = (sigma_m * sigma_m) * prior_covariance_m2.inverse();
         H->topLeftCorner<2, 2>() += information;
         g->head<2>() += information * (prior_m - reference_m);
@@ -1049,6 +1055,7 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
     tracked_frames_ = 0;
     tracked_.clear();
     lateral_history_.clear();
+    lateral_disagreeing_frames_ = 0;
     result.status = EstimateStatus::kLost;
     result.reason = reason;
     result.covariance.setZero();
@@ -1123,6 +1130,7 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
   contours_extracted_ = false;
   consensus_voted_ = false;
   lateral_this_frame_.reset();
+  lateral_beyond_this_frame_ = false;
   *aligned = true;
   const Alignment a =
       acquiring ? acquire(T_predicted)
@@ -1256,11 +1264,13 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
     tracked_.clear();
   }
   if (!acquiring && degraded.empty() && lateral_this_frame_ && options_.lateral_history_frames > 0) {
+    lateral_disagreeing_frames_ = lateral_beyond_this_frame_ ? lateral_disagreeing_frames_ + 1 : 0;
     lateral_history_.push_back(*lateral_this_frame_);
     if (static_cast<int>(lateral_history_.size()) > options_.lateral_history_frames)
       lateral_history_.erase(lateral_history_.begin());
   } else {
     lateral_history_.clear();
+    lateral_disagreeing_frames_ = 0;
   }
   if (degraded.empty()) {
     result.status = EstimateStatus::kTracking;
