@@ -1054,8 +1054,7 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
   auto lost = [&](const std::string& reason) {
     tracked_frames_ = 0;
     tracked_.clear();
-    lateral_history_.clear();
-    lateral_disagreeing_frames_ = 0;
+    clearLateralHistory();
     result.status = EstimateStatus::kLost;
     result.reason = reason;
     result.covariance.setZero();
@@ -1269,8 +1268,7 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
     if (static_cast<int>(lateral_history_.size()) > options_.lateral_history_frames)
       lateral_history_.erase(lateral_history_.begin());
   } else {
-    lateral_history_.clear();
-    lateral_disagreeing_frames_ = 0;
+    clearLateralHistory();
   }
   if (degraded.empty()) {
     result.status = EstimateStatus::kTracking;

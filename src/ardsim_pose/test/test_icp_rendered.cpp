@@ -772,6 +772,36 @@ Eigen::Isometry3d hubbleHoldPath(int k) {
   T.translation() = first + s * (last - first);
   return T;
 }
+// Frame k as rendered: the path, and in frames [jump_first, jump_end) the target 20 mm across the boresight.
+Eigen::Isometry3d hubbleHoldRendered(int k, int jump_first, int jump_end) {
+  Eigen::Isometry3d T = hubbleHoldPath(k);
+  if (k >= jump_first && k < jump_end) T.translation().x() += 0.02;
+  return T;
+}
+// The estimates (T_lidar_target) along the path's first `frames` frames, `method: icp` from the truth, noise
+// on (simulator_seed), none of them LOST.
+std::vector<Eigen::Isometry3d> hubbleHoldEstimates(PoseConfig config, int simulator_seed, int frames,
+                                                   int jump_first = 0, int jump_end = 0) {
+  config.method = "icp";
+  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, simulator_seed);
+  simulator.setTarget(ardsim_description::buildHubble());
+  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
+  ardsim_lidar::LidarFrame rendered;
+  std::vector<Eigen::Isometry3d> estimates;
+  for (int k = 0; k < frames; ++k) {
+    const Eigen::Isometry3d truth = hubbleHoldRendered(k, jump_first, jump_end);
+    if (k == 0) estimator->setPrior(truth);
+    simulator.simulate(truth, static_cast<std::uint64_t>(k), &rendered);
+    const EstimatorOutput out = estimator->process(fromLidarFrame(rendered, simulator.rays(), 0.1 * k));
+    EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
+    estimates.push_back(out.result.T_lidar_target);
+  }
+  return estimates;
+}
+double hubblePortErrorM(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth) {
+  return poseError(estimate, truth, ardsim_description::T_target_port(TargetKind::kHubble))
+      .port_position_error_m.norm();
+}
 struct PortError {
   double rms_m = 0.0;
   double worst_m = 0.0;
@@ -779,25 +809,15 @@ struct PortError {
 PortError hubbleLateralError(int lateral_history_frames, double lateral_vote_weight, int simulator_seed = 3,
                              int lateral_gate_frames = 0 /* 0: the default */) {
   PoseConfig config = hubbleDefaults();
-  config.method = "icp";
   config.icp.lateral_history_frames = lateral_history_frames;
   config.icp.lateral_vote_weight = lateral_vote_weight;
   if (lateral_gate_frames > 0) config.icp.lateral_gate_frames = lateral_gate_frames;
-  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, simulator_seed);
-  simulator.setTarget(ardsim_description::buildHubble());
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
-  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
-  ardsim_lidar::LidarFrame rendered;
+  const std::vector<Eigen::Isometry3d> estimates =
+      hubbleHoldEstimates(config, simulator_seed, kHubbleHoldPathFrames);
   PortError error;
   int count = 0;
-  for (int k = 0; k < kHubbleHoldPathFrames; ++k) {
-    const Eigen::Isometry3d truth = hubbleHoldPath(k);
-    if (k == 0) estimator->setPrior(truth);
-    simulator.simulate(truth, static_cast<std::uint64_t>(k), &rendered);
-    const EstimatorOutput out = estimator->process(fromLidarFrame(rendered, simulator.rays(), 0.1 * k));
-    EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    if (k < 20) continue;
-    const double e = poseError(out.result.T_lidar_target, truth, T_target_port).port_position_error_m.norm();
+  for (int k = 20; k < kHubbleHoldPathFrames; ++k) {
+    const double e = hubblePortErrorM(estimates[k], hubbleHoldPath(k));
     error.rms_m += e * e;
     error.worst_m = std::max(error.worst_m, e);
     ++count;
@@ -855,28 +875,15 @@ struct JumpErrors {
 };
 JumpErrors hubbleErrorsAfterJump(int lateral_gate_frames, int jump_frames) {
   PoseConfig config = hubbleDefaults();
-  config.method = "icp";
   config.icp.lateral_gate_frames = lateral_gate_frames;
-  ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, 3);
-  simulator.setTarget(ardsim_description::buildHubble());
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
-  const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
   constexpr int kJumpFrame = 80, kFrames = 90;
-  ardsim_lidar::LidarFrame rendered;
+  const std::vector<Eigen::Isometry3d> estimates =
+      hubbleHoldEstimates(config, 3, kFrames, kJumpFrame, kJumpFrame + jump_frames);
   JumpErrors errors;
-  for (int k = 0; k < kFrames; ++k) {
-    const Eigen::Isometry3d path = hubbleHoldPath(k);
-    Eigen::Isometry3d truth = path;
-    if (k >= kJumpFrame && k < kJumpFrame + jump_frames) truth.translation().x() += 0.02;
-    if (k == 0) estimator->setPrior(truth);
-    simulator.simulate(truth, static_cast<std::uint64_t>(k), &rendered);
-    const EstimatorOutput out = estimator->process(fromLidarFrame(rendered, simulator.rays(), 0.1 * k));
-    EXPECT_NE(out.result.status, EstimateStatus::kLost) << "frame " << k << ": " << out.result.reason;
-    if (k < kJumpFrame) continue;
-    errors.path_m.push_back(
-        poseError(out.result.T_lidar_target, path, T_target_port).port_position_error_m.norm());
+  for (int k = kJumpFrame; k < kFrames; ++k) {
+    errors.path_m.push_back(hubblePortErrorM(estimates[k], hubbleHoldPath(k)));
     errors.rendered_m.push_back(
-        poseError(out.result.T_lidar_target, truth, T_target_port).port_position_error_m.norm());
+        hubblePortErrorM(estimates[k], hubbleHoldRendered(k, kJumpFrame, kJumpFrame + jump_frames)));
   }
   return errors;
 }

@@ -213,8 +213,7 @@ class IcpTracker : public PoseMethod {
     acquired_.clear();
     tracked_frames_ = 0;
     tracked_.clear();
-    lateral_history_.clear();
-    lateral_disagreeing_frames_ = 0;
+    clearLateralHistory();
   }
 
   bool acquiring() const { return acquiring_; }
@@ -421,8 +420,12 @@ class IcpTracker : public PoseMethod {
   Eigen::Vector3d lateral_reference_target_ = Eigen::Vector3d::Zero();  // the point measured, target frame
   std::optional<LateralMeasurement> lateral_this_frame_;  // by its last consensus (none: no consensus)
   bool lateral_beyond_this_frame_ = false;                // ... beyond 3 sigma of the line
-  int lateral_disagreeing_frames_ =
-      0;  // the tracking frames in a row before this one whose own was beyond it
+  // The tracking frames in a row before this one whose own measurement lay beyond 3 sigma of the line.
+  int lateral_disagreeing_frames_ = 0;
+  void clearLateralHistory() {
+    lateral_history_.clear();
+    lateral_disagreeing_frames_ = 0;
+  }
   // The history's weighted straight line at stamp_s: the position and its covariance (false: fewer than
   // three measurements, or no spread in time).
   bool lateralPrior(double stamp_s, Eigen::Vector2d* position_m, Eigen::Matrix2d* covariance_m2) const;
