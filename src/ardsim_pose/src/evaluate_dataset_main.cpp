@@ -27,7 +27,11 @@ constexpr const char* kUsage =
     "--init truth: the first frame starts from its truth; perturbed (default): from the coarse prior\n"
     "(truth turned 10 deg about the port, port range 10 % off, 2 m lateral; directions seeded by --seed).\n"
     "Prints per range band (lidar to port) the position error of the port and the attitude error: the whole\n"
-    "rotation (att), its part across the boresight (tilt) and about it (bore); LOST frames are left out.";
+    "rotation (att), its part across the boresight (tilt) and about it (bore), and how the estimate's\n"
+    "covariance fits its errors: the RMS of each error over its sigma (z_lat: the port across the "
+    "boresight,\n"
+    "z_rng: along it, z_att: the attitude; 1 = the covariance is right, < 1 pessimistic, > 1 optimistic).\n"
+    "LOST frames are left out.";
 
 struct Arguments {
   std::string dataset;
@@ -91,6 +95,9 @@ Arguments parseArguments(int argc, char** argv) {
 struct Band {
   double min_m = 0.0, max_m = 0.0;
   std::vector<double> pos, att, tilt, boresight, ms;  // tilt: across the boresight; boresight: about it
+  // Errors over the estimate's own sigmas (normalizedError): the port across the boresight (x and y), along
+  // it, the attitude about all three axes.
+  std::vector<double> z_lateral, z_range, z_attitude;
   int frames = 0, lost = 0;
 };
 
@@ -138,7 +145,8 @@ int run(int argc, char** argv) {
   std::ofstream csv(args.out);
   if (!csv) throw std::runtime_error("cannot write " + args.out);
   csv << "frame,stamp_s,status,x,y,z,qx,qy,qz,qw,range_m,pos_err_m,att_err_deg,fit_rms_m,inlier_fraction,"
-         "points_used,iterations,ms,reason\n";
+         "points_used,iterations,ms,reason,port_sigma_x_m,port_sigma_y_m,port_sigma_z_m,att_sigma_x_deg,"
+         "att_sigma_y_deg,att_sigma_z_deg\n";
   csv.precision(10);
   std::vector<Band> bands;
   for (const auto& [min_m, max_m] :
@@ -158,6 +166,8 @@ int run(int argc, char** argv) {
     const ardsim_pose::PoseErrorValue e =
         ardsim_pose::poseError(out.result.T_lidar_target, truth[k].T_lidar_target, T_target_port);
     const bool lost = out.result.status == ardsim_pose::EstimateStatus::kLost;
+    const ardsim_pose::NormalizedError z =
+        ardsim_pose::normalizedError(e, out.result.covariance, out.result.T_lidar_target, T_target_port);
     const double pos = e.port_position_error_m.norm();
     const double att_deg = e.attitude_error_angle_rad * 180.0 / M_PI;
     for (Band* band : {&all, &*std::find_if(bands.begin(), bands.end(), [&](const Band& b) {
@@ -172,6 +182,11 @@ int run(int argc, char** argv) {
         band->att.push_back(att_deg);
         band->tilt.push_back(e.attitude_error_rad.head<2>().norm() * 180.0 / M_PI);
         band->boresight.push_back(std::abs(e.attitude_error_rad.z()) * 180.0 / M_PI);
+        if (z.port_sigma_m.minCoeff() > 0.0 && z.attitude_sigma_rad.minCoeff() > 0.0) {
+          band->z_lateral.insert(band->z_lateral.end(), {z.port_position.x(), z.port_position.y()});
+          band->z_range.push_back(z.port_position.z());
+          band->z_attitude.insert(band->z_attitude.end(), z.attitude.data(), z.attitude.data() + 3);
+        }
       }
     }
     const Eigen::Quaterniond q(out.result.T_lidar_target.linear());
@@ -180,10 +195,16 @@ int run(int argc, char** argv) {
         << t.y() << ',' << t.z() << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w() << ','
         << e.range_m << ',' << pos << ',' << att_deg << ',' << out.result.fit_rms_m << ','
         << out.result.inlier_fraction << ',' << out.result.points_used << ',' << out.result.iterations << ','
-        << out.compute_ms << ",\"" << out.result.reason << "\"\n";
+        << out.compute_ms << ",\"" << out.result.reason << "\"";
+    const Eigen::Vector3d att_sigma_deg = z.attitude_sigma_rad * (180.0 / M_PI);
+    for (double sigma : {z.port_sigma_m.x(), z.port_sigma_m.y(), z.port_sigma_m.z(), att_sigma_deg.x(),
+                         att_sigma_deg.y(), att_sigma_deg.z()})
+      csv << ',' << sigma;
+    csv << '\n';
   }
-  std::printf("%-12s %6s %5s %10s %10s %11s %11s %12s %12s %8s\n", "range_m", "frames", "lost", "pos_rms_m",
-              "pos_max_m", "att_rms_deg", "att_max_deg", "tilt_rms_deg", "bore_rms_deg", "ms_med");
+  std::printf("%-12s %6s %5s %10s %10s %11s %11s %12s %12s %8s %6s %6s %6s\n", "range_m", "frames", "lost",
+              "pos_rms_m", "pos_max_m", "att_rms_deg", "att_max_deg", "tilt_rms_deg", "bore_rms_deg",
+              "ms_med", "z_lat", "z_rng", "z_att");
   for (const Band& b : bands) {
     if (b.frames == 0) continue;
     char label[32];
@@ -191,9 +212,9 @@ int run(int argc, char** argv) {
       std::snprintf(label, sizeof(label), ">= %.0f", b.min_m);
     else
       std::snprintf(label, sizeof(label), "%.0f-%.0f", b.min_m, b.max_m);
-    std::printf("%-12s %6d %5d %10.4f %10.4f %11.4f %11.4f %12.4f %12.4f %8.2f\n", label, b.frames, b.lost,
-                rms(b.pos), maxOf(b.pos), rms(b.att), maxOf(b.att), rms(b.tilt), rms(b.boresight),
-                medianOf(b.ms));
+    std::printf("%-12s %6d %5d %10.4f %10.4f %11.4f %11.4f %12.4f %12.4f %8.2f %6.2f %6.2f %6.2f\n", label,
+                b.frames, b.lost, rms(b.pos), maxOf(b.pos), rms(b.att), maxOf(b.att), rms(b.tilt),
+                rms(b.boresight), medianOf(b.ms), rms(b.z_lateral), rms(b.z_range), rms(b.z_attitude));
   }
   std::printf(
       "summary frames=%d lost=%d pos_rms_m=%.4f pos_max_m=%.4f att_rms_deg=%.4f att_max_deg=%.4f "

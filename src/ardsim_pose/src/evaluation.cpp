@@ -19,6 +19,23 @@ PoseErrorValue poseError(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d
   return e;
 }
 
+NormalizedError normalizedError(const PoseErrorValue& error, const Eigen::Matrix<double, 6, 6>& covariance,
+                                const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_target_port) {
+  // The port moves with the origin's translation and, for a rotation w (lidar frame, left), by w x lever.
+  const Eigen::Vector3d lever = T_est.linear() * T_target_port.translation();
+  Eigen::Matrix<double, 3, 6> J;
+  J.leftCols<3>().setIdentity();
+  J.rightCols<3>() << 0.0, lever.z(), -lever.y(), -lever.z(), 0.0, lever.x(), lever.y(), -lever.x(), 0.0;
+  NormalizedError n;
+  n.port_sigma_m = (J * covariance * J.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
+  n.attitude_sigma_rad = covariance.bottomRightCorner<3, 3>().diagonal().cwiseMax(0.0).cwiseSqrt();
+  for (int i = 0; i < 3; ++i) {
+    if (n.port_sigma_m(i) > 0.0) n.port_position(i) = error.port_position_error_m(i) / n.port_sigma_m(i);
+    if (n.attitude_sigma_rad(i) > 0.0) n.attitude(i) = error.attitude_error_rad(i) / n.attitude_sigma_rad(i);
+  }
+  return n;
+}
+
 Eigen::Isometry3d dockingAxisPose(ardsim_description::TargetKind kind, double port_distance_m) {
   using namespace ardsim_description;
   Eigen::Isometry3d T_port_chaser_port = T_port_port_docked();

@@ -382,7 +382,9 @@ void IcpTracker::stepWeakDirections(const Eigen::Matrix<double, 6, 6>& H_scaled,
 }
 
 bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, double min_information,
-                             Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g) {
+                             Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g,
+                             bool* consensus) {
+  *consensus = false;
   if (cloud_ == nullptr || slots_[current_].depth_only) return false;
   if (!contours_extracted_) {
     contours_.extract(*cloud_, gated_);
@@ -399,6 +401,7 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
   }
   const double sigma_m = a.limit_m / options_.tukey_c;
   if (!with_boresight_rotation && visibility().nearestDepth() >= options_.contour_consensus_min_depth_m) {
+    *consensus = true;
     // The vote again after the pose moved a quarter pixel (the members chosen there may not hold at the new
     // pose: from an approach dataset's predictions 0.5 m off in range, two of 24 runs slid 1-2 cm off), else
     // the same members: a vote at every iteration moved the winner from cell to cell with the pose, and the
@@ -774,11 +777,13 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
     // but whether the roll needs holding was tuned on the planes': Hubble's datasets, with the contours' roll
     // in tracking then, 30-50 m attitude RMS max 0.032 -> 0.027 deg this way).
     const double boresight_information = boresightInformation(H_scaled, largest);
+    bool consensus_used = false;
     // Where the planes leave directions weak (Hubble's bulkhead face-on: across it, and its roll), the
-    // occluding contours measure them too (IcpOptions::contour_sigma_px). In the step only: the covariance
-    // and the quality checks stay the planes' (the contours' residuals are not independent, and a composite
-    // pose takes ICP's roll where its covariance says it is good: with the contours in it, it took Hubble's
-    // at 10-20 m, from contours near the port, 0.14 deg RMS off there instead of 0.02).
+    // occluding contours measure them too (IcpOptions::contour_sigma_px). The quality checks stay the
+    // planes', and so does the covariance but for the consensus below (the midpoints' residuals are not
+    // independent, and a composite pose takes ICP's roll where its covariance says it is good: with the
+    // midpoints in it, it took Hubble's at 10-20 m, from contours near the port, 0.14 deg RMS off there
+    // instead of 0.02).
     // The boresight rotation from them only while acquiring (from a coarse prior, a dataset run's first
     // frame 1.7 deg off without): tracking, it stays the planes' and the prior's, which average it over
     // frames; the contours' sub-pixel errors last for frames in a slow approach (hubble_hold, lidar seeds 2 /
@@ -791,11 +796,20 @@ IcpTracker::Alignment IcpTracker::align(const Eigen::Isometry3d& T_start, double
         // The consensus at no less than twice the weak directions' limit: below it the tangential offsets
         // took its directions over (the approach datasets with a floor of 0.02 px and no such bound: frames
         // at 47-50 m 1-4 cm off).
-        addContours(a, !tracking, 2.0 * options_.weak_direction_condition * largest, &H, &g)) {
+        addContours(a, !tracking, 2.0 * options_.weak_direction_condition * largest, &H, &g,
+                    &consensus_used)) {
       H_scaled = leverScaled(H, a.centre);
       largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(H_scaled, Eigen::EigenvaluesOnly)
                     .eigenvalues()(5);
     }
+    // The covariance takes the consensus and the line, not the midpoints' rows: those along one edge share
+    // its sub-pixel phase, and inside 10 m a pixel is small against the tilt's and the model's errors, so
+    // their information overstates (Hubble's approach datasets, ICP alone, 0-10 m: the port's lateral error
+    // 2.8-3.6 times the sigma they give).
+    if (consensus_used)
+      a.H_lateral = H - a.H;
+    else
+      a.H_lateral.setZero();
     const bool boresight_well_observed = boresight_information >= 10.0 * options_.degraded_condition;
     if (boresight_information > options_.degraded_condition) {
       // Tracking, with the boresight rotation barely observed (below 10 x the observed limit: Hubble's
@@ -1154,19 +1168,22 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
 
   // Covariance of (v, w) about the centre from the last normal equations, the boresight rotation's prior
   // included where the last iteration took it (its sigma then bounds that rotation's: a roll averaged over
-  // frames by the prior is known better than one frame's planes say, and the composite pose takes ICP's roll
-  // by it, EstimatorOptions::composite_icp_roll_max_sigma_deg), mapped to the target origin's position and
-  // the rotation: delta_origin = v + w x (origin - centre).
+  // frames by the prior is known better than one frame's planes say), and the contours' consensus with the
+  // lateral line where they were in it (Alignment::H_lateral: Hubble's rim across the boresight to ~0.5 mm,
+  // where the planes alone said 2-3 mm), mapped to the target origin's position and the rotation:
+  // delta_origin = v + w x (origin - centre). H_lateral was weighed in the robust sigma's units, the
+  // covariance is in the residuals' variance: rescaled. (The composite pose, which takes ICP's roll by this
+  // covariance, runs nearer than the consensus: 10-20 m for Hubble, and the ISS has none.)
   const double dof = std::max(1.0, weight_sum - 6.0);
   const double variance = std::max(weighted_sq_sum / dof, options_.min_sigma_m * options_.min_sigma_m);
+  const double robust_sigma_m = a.limit_m / options_.tukey_c;
   Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Identity();
   A.block<3, 3>(0, 3) = -skew(T.translation() - centre);
-  Eigen::Matrix<double, 6, 6> H_posterior = H;
+  Eigen::Matrix<double, 6, 6> H_posterior = H + (variance / (robust_sigma_m * robust_sigma_m)) * a.H_lateral;
   if (a.boresight_prior_rad > 0.0)
     H_posterior(5, 5) += variance / (a.boresight_prior_rad * a.boresight_prior_rad);
-  const Eigen::Matrix<double, 6, 6> H_inverse =
-      H_posterior.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
-  result.covariance = A * (variance * H_inverse) * A.transpose();
+  result.covariance =
+      A * (variance * H_posterior.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity())) * A.transpose();
 
   // Condition of the lever-scaled normal equations.
   const Eigen::Matrix<double, 6, 6> H_scaled = leverScaled(H, centre);

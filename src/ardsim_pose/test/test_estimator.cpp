@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "ardsim_pose/estimator_factory.h"
+#include "ardsim_pose/evaluation.h"
 #include "ardsim_pose/pose_estimator.h"
 #include "expect_refused.h"
 
@@ -46,6 +47,30 @@ class ScriptedMethod : public PoseMethod {
 };
 
 // A return is finite in all three coordinates and in front of the sensor (one test for the three: v - v).
+// The port's sigma takes the rotation's through the lever from the origin; each error over its own sigma.
+TEST(NormalizedError, PortSigmaThroughTheLeverAndErrorsOverSigmas) {
+  Eigen::Isometry3d T_target_port = Eigen::Isometry3d::Identity();
+  T_target_port.translation() = Eigen::Vector3d(0.0, 0.0, -5.0);  // 5 m nearer the lidar than the origin
+  const Eigen::Isometry3d T_estimated(Eigen::Translation3d(0.0, 0.0, 40.0));
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  covariance.diagonal() << 1e-6, 4e-6, 9e-6, 1e-8, 0.0, 0.0;  // sigmas 1, 2, 3 mm; 0.1 mrad about x
+  PoseErrorValue error;
+  error.port_position_error_m = Eigen::Vector3d(0.001, 0.001, -0.006);
+  error.attitude_error_rad = Eigen::Vector3d(0.0002, 0.0, 0.0);
+  const NormalizedError z = normalizedError(error, covariance, T_estimated, T_target_port);
+  // A turn w about x moves the port (lever (0, 0, -5)) by w x lever = (0, 5 w, 0): y's sigma is
+  // sqrt(2^2 + 0.5^2) mm.
+  EXPECT_NEAR(z.port_sigma_m.x(), 0.001, 1e-12);
+  EXPECT_NEAR(z.port_sigma_m.y(), std::sqrt(4e-6 + 0.25e-6), 1e-12);
+  EXPECT_NEAR(z.port_sigma_m.z(), 0.003, 1e-12);
+  EXPECT_NEAR(z.port_position.x(), 1.0, 1e-9);
+  EXPECT_NEAR(z.port_position.y(), 0.001 / std::sqrt(4.25e-6), 1e-9);
+  EXPECT_NEAR(z.port_position.z(), -2.0, 1e-9);
+  EXPECT_NEAR(z.attitude.x(), 2.0, 1e-9);
+  EXPECT_EQ(z.attitude.y(), 0.0);  // no sigma: no ratio
+  EXPECT_EQ(z.attitude_sigma_rad.z(), 0.0);
+}
+
 TEST(IsReturn, FiniteAndInFrontOnly) {
   const float inf = std::numeric_limits<float>::infinity();
   const float nan = std::numeric_limits<float>::quiet_NaN();

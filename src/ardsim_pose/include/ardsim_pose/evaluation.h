@@ -29,6 +29,20 @@ PoseErrorValue poseError(const Eigen::Isometry3d& T_lidar_target_estimated,
                          const Eigen::Isometry3d& T_lidar_target_truth,
                          const Eigen::Isometry3d& T_target_port);
 
+// The error in the units of the estimate's own covariance (PoseResult::covariance: the target origin's
+// position and rotation in lidar_optical): each component of the port position error and of the attitude
+// error (both in lidar_optical) over its sigma, the port's propagated through the lever from the origin. A
+// covariance that says what the errors are gives an RMS of 1 on every axis; below 1 it is pessimistic.
+struct NormalizedError {
+  Eigen::Vector3d port_sigma_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d attitude_sigma_rad = Eigen::Vector3d::Zero();
+  Eigen::Vector3d port_position = Eigen::Vector3d::Zero();  // error / sigma (0 where a sigma is 0)
+  Eigen::Vector3d attitude = Eigen::Vector3d::Zero();
+};
+NormalizedError normalizedError(const PoseErrorValue& error, const Eigen::Matrix<double, 6, 6>& covariance,
+                                const Eigen::Isometry3d& T_lidar_target_estimated,
+                                const Eigen::Isometry3d& T_target_port);
+
 // T_lidar_target with the chaser in docking attitude on the docking axis, its port port_distance_m out along
 // target_port x; the lidar sits on the chaser port axis (T_chaser_lidar), so the target port is on the
 // boresight.

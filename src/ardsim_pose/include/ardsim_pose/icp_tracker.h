@@ -240,7 +240,11 @@ class IcpTracker : public PoseMethod {
     double weight_sum = 0.0;
     double weighted_sq_sum = 0.0;
     double limit_m = 0.0;  // the Tukey limit of the last iteration
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();  // the planes'
+    // What the contours' consensus and the lateral line through its history added to H in the last
+    // iteration (not the midpoints' rows: below), in the units of the planes' robust sigma (limit_m /
+    // tukey_c) squared.
+    Eigen::Matrix<double, 6, 6> H_lateral = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     bool boresight_held = false;       // the last iteration held the boresight rotation near a prior
     double boresight_prior_rad = 0.0;  // the last iteration's prior on that rotation (held or fused; 0: none)
@@ -302,9 +306,9 @@ class IcpTracker : public PoseMethod {
   // (IcpOptions::contour_sigma_px): the frame's edge pairs once, the model points near them again once the
   // pose moved a pixel or the visibility changed; with_boresight_rotation: the rows measure the rotation
   // about the boresight too (else, at contour_consensus_min_depth_m and beyond, the lateral translation by
-  // consensus, with no less information than min_information). Whether any row was added.
+  // consensus, with no less information than min_information: *consensus). Whether any row was added.
   bool addContours(const Alignment& a, bool with_boresight_rotation, double min_information,
-                   Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g);
+                   Eigen::Matrix<double, 6, 6>* H, Eigen::Matrix<double, 6, 1>* g, bool* consensus);
   // The smallest eigenvalue of H_scaled's first five unknowns (all but the boresight rotation).
   double weakestOfFive(const Eigen::Matrix<double, 6, 6>& H_scaled) const;
   // Whether lever-scaled normal equations (largest eigenvalue `largest`) constrain the rotation about the
