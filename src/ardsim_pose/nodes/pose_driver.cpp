@@ -83,6 +83,8 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/contour_max_depth_m", &i.contour_max_depth_m);
   read(nh, "icp/contour_consensus_min_depth_m", &i.contour_consensus_min_depth_m);
   read(nh, "icp/lateral_history_frames", &i.lateral_history_frames);
+  read(nh, "icp/lateral_line_frames", &i.lateral_line_frames);
+  read(nh, "icp/lateral_line_sigma_m", &i.lateral_line_sigma_m);
   read(nh, "icp/lateral_gate_frames", &i.lateral_gate_frames);
   read(nh, "icp/lateral_vote_weight", &i.lateral_vote_weight);
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);

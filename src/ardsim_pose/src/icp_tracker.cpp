@@ -38,6 +38,9 @@ constexpr double kContourWindowPx = 3.0;
 // the pairs vote again.
 constexpr double kConsensusReachPx = 2.0;
 constexpr double kConsensusFloorPx = 0.02;
+// Two nested lateral lines agree below this chi^2 of their difference (position and rate: 4 degrees of
+// freedom, ~14 % of agreeing pairs beyond it).
+constexpr double kLateralLinesAgreeChi2 = 7.0;
 constexpr double kConsensusRevotePx = 0.25;
 // The first coarse iteration's sparse start (IcpOptions::sparse_start_residual_m): every
 // kSparseFirstStride-th scan point.
@@ -137,6 +140,10 @@ void validate(const IcpOptions& o) {
                 "icp/contour_consensus_min_depth_m", o.contour_consensus_min_depth_m, ">= 0 (inf: never)");
   requireOption(o.lateral_history_frames >= 0 && o.lateral_history_frames <= 1000,
                 "icp/lateral_history_frames", o.lateral_history_frames, "0 .. 1000");
+  requireOption(o.lateral_line_frames >= 3 && o.lateral_line_frames <= 1000, "icp/lateral_line_frames",
+                o.lateral_line_frames, "3 .. 1000");
+  requireOption(o.lateral_line_sigma_m >= 0.0 && o.lateral_line_sigma_m <= 1.0, "icp/lateral_line_sigma_m",
+                o.lateral_line_sigma_m, "0 .. 1");
   requireOption(o.lateral_gate_frames >= 1 && o.lateral_gate_frames <= 1000, "icp/lateral_gate_frames",
                 o.lateral_gate_frames, "1 .. 1000");
   requireOption(o.lateral_vote_weight >= 0.0 && o.lateral_vote_weight <= 100.0, "icp/lateral_vote_weight",
@@ -448,24 +455,48 @@ bool IcpTracker::lateralPrior(double stamp_s, Eigen::Vector2d* position_m,
                               Eigen::Matrix2d* covariance_m2) const {
   if (lateral_history_.size() < 3) return false;
   // position(t) = p + (t - stamp_s) v, weighted by each measurement's information.
-  Eigen::Matrix4d N = Eigen::Matrix4d::Zero();
-  Eigen::Vector4d b = Eigen::Vector4d::Zero();
-  for (const LateralMeasurement& m : lateral_history_) {
-    const double dt = m.stamp_s - stamp_s;
-    const Eigen::Matrix2d W = m.covariance_m2.inverse();
-    N.topLeftCorner<2, 2>() += W;
-    N.topRightCorner<2, 2>() += dt * W;
-    N.bottomLeftCorner<2, 2>() += dt * W;
-    N.bottomRightCorner<2, 2>() += dt * dt * W;
-    b.head<2>() += W * m.position_m;
-    b.tail<2>() += dt * W * m.position_m;
+  auto fit = [&](std::size_t first, Eigen::Vector4d* line, Eigen::Matrix4d* C) {
+    Eigen::Matrix4d N = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+    for (std::size_t k = first; k < lateral_history_.size(); ++k) {
+      const LateralMeasurement& m = lateral_history_[k];
+      const double dt = m.stamp_s - stamp_s;
+      const Eigen::Matrix2d W = m.covariance_m2.inverse();
+      N.topLeftCorner<2, 2>() += W;
+      N.topRightCorner<2, 2>() += dt * W;
+      N.bottomLeftCorner<2, 2>() += dt * W;
+      N.bottomRightCorner<2, 2>() += dt * dt * W;
+      b.head<2>() += W * m.position_m;
+      b.tail<2>() += dt * W * m.position_m;
+    }
+    const Eigen::FullPivLU<Eigen::Matrix4d> lu(N);
+    if (!lu.isInvertible()) return false;
+    *C = lu.inverse();
+    *line = *C * b;
+    return line->allFinite() && C->allFinite();
+  };
+  // The newest lateral_line_frames' line; the whole history's where that one is weak and the two agree
+  // (IcpOptions::lateral_line_sigma_m).
+  const std::size_t newest = static_cast<std::size_t>(options_.lateral_line_frames);
+  const std::size_t first = lateral_history_.size() > newest ? lateral_history_.size() - newest : 0;
+  Eigen::Vector4d line;
+  Eigen::Matrix4d C;
+  if (!fit(first, &line, &C)) return false;
+  if (first > 0 && std::sqrt(0.5 * C.topLeftCorner<2, 2>().trace()) > options_.lateral_line_sigma_m) {
+    Eigen::Vector4d line_all;
+    Eigen::Matrix4d C_all;
+    if (fit(0, &line_all, &C_all)) {
+      // The longer line's estimate is the more precise of two nested ones, so their difference has the
+      // covariance C - C_all (Hausman); position and rate both, or two lines through a jump cross.
+      const Eigen::Vector4d d = line - line_all;
+      const Eigen::LLT<Eigen::Matrix4d> llt(C - C_all);
+      if (llt.info() == Eigen::Success && d.dot(llt.solve(d)) < kLateralLinesAgreeChi2)
+        line = line_all, C = C_all;
+    }
   }
-  const Eigen::FullPivLU<Eigen::Matrix4d> lu(N);
-  if (!lu.isInvertible()) return false;
-  const Eigen::Matrix4d covariance = lu.inverse();
-  *position_m = (covariance * b).head<2>();
-  *covariance_m2 = covariance.topLeftCorner<2, 2>();
-  return position_m->allFinite() && covariance_m2->allFinite();
+  *position_m = line.head<2>();
+  *covariance_m2 = C.topLeftCorner<2, 2>();
+  return true;
 }
 
 double IcpTracker::weakestOfFive(const Eigen::Matrix<double, 6, 6>& H_scaled) const {

@@ -85,14 +85,21 @@ struct IcpOptions {
   // 6.6 mm; hubble_hold's roll at 10-20 m, which the composite takes from ICP: worst frame 0.07 -> 0.12 deg).
   double contour_consensus_min_depth_m = 25.0;
   // ... and where it does, a prior on that translation from the consensus's own measurements of the last
-  // lateral_history_frames tracking frames in a row: the straight line through them (each weighted by its
-  // polygon's covariance) at the frame's stamp, with that fit's covariance, where the frame's own measurement
-  // lies within 3 sigma of it (a manoeuvre the line does not follow is not followed). A frame's pixels place
-  // Hubble's rim to ~1 mm at 30-50 m, the line through ten frames to ~0.6 (hubble_hold, five lidar seeds:
-  // ICP 30-50 m port position RMS 0.96-1.02 -> 0.62-0.66 mm). Longer lines lag: in the closed loop the
-  // chaser's attitude control swings the target across the lidar frame by millimetres in a second (20
-  // frames: 25-30 m biased 0.8-0.95 mm). 0: none.
-  int lateral_history_frames = 10;
+  // lateral_history_frames tracking frames in a row: the straight line through the newest lateral_line_frames
+  // of them (each weighted by its polygon's covariance) at the frame's stamp, with that fit's covariance,
+  // where the frame's own measurement lies within 3 sigma of it (a manoeuvre the line does not follow is not
+  // followed). A frame's pixels place Hubble's rim to ~1 mm at 30-50 m, the line through ten frames to ~0.6
+  // (hubble_hold, five lidar seeds: ICP 30-50 m port position RMS 0.96-1.02 -> 0.62-0.66 mm). Longer lines
+  // lag: in the closed loop the chaser's attitude control swings the target across the lidar frame by
+  // millimetres in a second (20 frames always: 25-30 m biased 0.8-0.95 mm). 0: none.
+  int lateral_history_frames = 20;
+  int lateral_line_frames = 10;
+  // ... but through the whole history where the newest frames' line is weaker than this at the frame (sigma,
+  // m: each frame's own measurement is weak, Hubble beyond ~35 m) and the two lines agree (position and
+  // rate within chi^2 7 of their difference: a manoeuvre the longer line would lag is not averaged in).
+  // hubble_hold, five lidar seeds: ICP 30-50 m port position RMS 0.58-0.62 -> 0.50-0.53 mm, worst frame
+  // 2.14-3.49 -> 1.81-2.13 mm, 20-30 m as before. 0: wherever they agree.
+  double lateral_line_sigma_m = 0.00075;
   // ... where the frame's own measurement lies beyond 3 sigma of the line, the line still counts unless
   // this many frames in a row have: a single such frame was the vote's error (a winner a cell off), not the
   // path's (hubble_hold, lidar seeds 37 and 51: the worst 30-50 m frame, 3.5 mm off where the line was
@@ -430,8 +437,8 @@ class IcpTracker : public PoseMethod {
     lateral_history_.clear();
     lateral_disagreeing_frames_ = 0;
   }
-  // The history's weighted straight line at stamp_s: the position and its covariance (false: fewer than
-  // three measurements, or no spread in time).
+  // The history's weighted straight line at stamp_s (IcpOptions::lateral_line_frames, lateral_line_sigma_m):
+  // the position and its covariance (false: fewer than three measurements, or no spread in time).
   bool lateralPrior(double stamp_s, Eigen::Vector2d* position_m, Eigen::Matrix2d* covariance_m2) const;
 };
 
