@@ -28,10 +28,9 @@ constexpr const char* kUsage =
     "(truth turned 10 deg about the port, port range 10 % off, 2 m lateral; directions seeded by --seed).\n"
     "Prints per range band (lidar to port) the position error of the port and the attitude error: the whole\n"
     "rotation (att), its part across the boresight (tilt) and about it (bore), and how the estimate's\n"
-    "covariance fits its errors: the RMS of each error over its sigma (z_lat: the port across the "
-    "boresight,\n"
-    "z_rng: along it, z_att: the attitude; 1 = the covariance is right, < 1 pessimistic, > 1 optimistic).\n"
-    "LOST frames are left out.";
+    "covariance fits its errors: the RMS of each error over its sigma (z_lat: the port across the\n"
+    "boresight, z_rng: along it, z_att: the attitude; 1 = the covariance is right, < 1 pessimistic,\n"
+    "> 1 optimistic). LOST frames are left out.";
 
 struct Arguments {
   std::string dataset;

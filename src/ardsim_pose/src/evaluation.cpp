@@ -4,6 +4,7 @@
 #include <random>
 
 #include "ardsim_dynamics/simulation.h"
+#include "ardsim_pose/pose_types.h"
 
 namespace ardsim_pose {
 
@@ -21,11 +22,12 @@ PoseErrorValue poseError(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d
 
 NormalizedError normalizedError(const PoseErrorValue& error, const Eigen::Matrix<double, 6, 6>& covariance,
                                 const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_target_port) {
-  // The port moves with the origin's translation and, for a rotation w (lidar frame, left), by w x lever.
+  // The port moves with the origin's translation and, for a rotation w (lidar frame, left), by w x lever
+  // = -skew(lever) w.
   const Eigen::Vector3d lever = T_est.linear() * T_target_port.translation();
   Eigen::Matrix<double, 3, 6> J;
   J.leftCols<3>().setIdentity();
-  J.rightCols<3>() << 0.0, lever.z(), -lever.y(), -lever.z(), 0.0, lever.x(), lever.y(), -lever.x(), 0.0;
+  J.rightCols<3>() = -skew(lever);
   NormalizedError n;
   n.port_sigma_m = (J * covariance * J.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
   n.attitude_sigma_rad = covariance.bottomRightCorner<3, 3>().diagonal().cwiseMax(0.0).cwiseSqrt();

@@ -94,12 +94,6 @@ bool onWideEdge(const OrganizedCloud& cloud, int u, int v) {
   return edgeAlong(1, 0) || edgeAlong(0, 1);
 }
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
 std::string format(const char* pattern, double a, double b = 0.0) {
   char text[160];
   std::snprintf(text, sizeof(text), pattern, a, b);

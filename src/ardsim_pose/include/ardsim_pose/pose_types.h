@@ -19,6 +19,13 @@ struct OrganizedCloud {
   double stamp_s = 0.0;
 };
 
+// The cross-product matrix: skew(v) u = v x u.
+inline Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
 // Whether a point of such a frame is a return: finite and in front of the sensor. (z first: most pixels of
 // a far target's frame have none, and the test runs on every pixel of every frame. Then one test for all
 // three finite: v - v is 0 for a finite v and NaN for an infinite or NaN one.)
