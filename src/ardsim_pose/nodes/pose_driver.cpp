@@ -86,6 +86,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "icp/lateral_line_frames", &i.lateral_line_frames);
   read(nh, "icp/lateral_line_sigma_m", &i.lateral_line_sigma_m);
   read(nh, "icp/lateral_gate_frames", &i.lateral_gate_frames);
+  read(nh, "icp/lateral_acceleration_chi2", &i.lateral_acceleration_chi2);
   read(nh, "icp/lateral_vote_weight", &i.lateral_vote_weight);
   read(nh, "icp/min_sigma_m", &i.min_sigma_m);
   read(nh, "icp/boresight_prior_deg", &i.boresight_prior_deg);

@@ -140,6 +140,8 @@ void validate(const IcpOptions& o) {
                 o.lateral_line_sigma_m, "0 .. 1");
   requireOption(o.lateral_gate_frames >= 1 && o.lateral_gate_frames <= 1000, "icp/lateral_gate_frames",
                 o.lateral_gate_frames, "1 .. 1000");
+  requireOption(o.lateral_acceleration_chi2 >= 0.0 && o.lateral_acceleration_chi2 <= 1e6,
+                "icp/lateral_acceleration_chi2", o.lateral_acceleration_chi2, "0 .. 1e6");
   requireOption(o.lateral_vote_weight >= 0.0 && o.lateral_vote_weight <= 100.0, "icp/lateral_vote_weight",
                 o.lateral_vote_weight, "0 .. 100");
   requireOption(positive(o.min_sigma_m), "icp/min_sigma_m", o.min_sigma_m, "> 0");
@@ -448,44 +450,77 @@ bool IcpTracker::addContours(const Alignment& a, bool with_boresight_rotation, d
 bool IcpTracker::lateralPrior(double stamp_s, Eigen::Vector2d* position_m,
                               Eigen::Matrix2d* covariance_m2) const {
   if (lateral_history_.size() < 3) return false;
-  // position(t) = p + (t - stamp_s) v, weighted by each measurement's information.
-  auto fit = [&](std::size_t first, Eigen::Vector4d* line, Eigen::Matrix4d* C) {
-    Eigen::Matrix4d N = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+  // position(t) = p + (t - stamp_s) v [+ (t - stamp_s)^2 / 2 a], weighted by each measurement's information;
+  // the unknowns (p, v[, a]) in the first 4 [6] of line and C.
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  auto fit = [&](std::size_t first, bool accelerating, Vector6d* line, Matrix6d* C) {
+    const int n = accelerating ? 6 : 4;
+    if (lateral_history_.size() - first < (accelerating ? 4u : 3u)) return false;
+    Matrix6d N = Matrix6d::Zero();
+    Vector6d b = Vector6d::Zero();
     for (std::size_t k = first; k < lateral_history_.size(); ++k) {
       const LateralMeasurement& m = lateral_history_[k];
       const double dt = m.stamp_s - stamp_s;
+      Eigen::Matrix<double, 2, 6> J = Eigen::Matrix<double, 2, 6>::Zero();
+      J.leftCols<2>().setIdentity();
+      J.middleCols<2>(2) = dt * Eigen::Matrix2d::Identity();
+      J.rightCols<2>() = 0.5 * dt * dt * Eigen::Matrix2d::Identity();
       const Eigen::Matrix2d W = m.covariance_m2.inverse();
-      N.topLeftCorner<2, 2>() += W;
-      N.topRightCorner<2, 2>() += dt * W;
-      N.bottomLeftCorner<2, 2>() += dt * W;
-      N.bottomRightCorner<2, 2>() += dt * dt * W;
-      b.head<2>() += W * m.position_m;
-      b.tail<2>() += dt * W * m.position_m;
+      N += J.transpose() * W * J;
+      b += J.transpose() * W * m.position_m;
     }
-    const Eigen::FullPivLU<Eigen::Matrix4d> lu(N);
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(N.topLeftCorner(n, n));
     if (!lu.isInvertible()) return false;
-    *C = lu.inverse();
-    *line = *C * b;
+    C->setZero();
+    line->setZero();
+    C->topLeftCorner(n, n) = lu.inverse();
+    line->head(n) = C->topLeftCorner(n, n) * b.head(n);
     return line->allFinite() && C->allFinite();
+  };
+  // The fit's chi^2 over the frames from first on.
+  auto misfit = [&](std::size_t first, const Vector6d& line) {
+    double chi2 = 0.0;
+    for (std::size_t k = first; k < lateral_history_.size(); ++k) {
+      const LateralMeasurement& m = lateral_history_[k];
+      const double dt = m.stamp_s - stamp_s;
+      const Eigen::Vector2d r =
+          m.position_m - line.head<2>() - dt * line.segment<2>(2) - 0.5 * dt * dt * line.tail<2>();
+      chi2 += r.dot(m.covariance_m2.ldlt().solve(r));
+    }
+    return chi2;
   };
   // The newest lateral_line_frames' line; the whole history's where that one is weak and the two agree
   // (IcpOptions::lateral_line_sigma_m).
   const std::size_t newest = static_cast<std::size_t>(options_.lateral_line_frames);
   const std::size_t first = lateral_history_.size() > newest ? lateral_history_.size() - newest : 0;
-  Eigen::Vector4d line;
-  Eigen::Matrix4d C;
-  if (!fit(first, &line, &C)) return false;
+  Vector6d line;
+  Matrix6d C;
+  if (!fit(first, false, &line, &C)) return false;
   if (first > 0 && std::sqrt(0.5 * C.topLeftCorner<2, 2>().trace()) > options_.lateral_line_sigma_m) {
-    Eigen::Vector4d line_all;
-    Eigen::Matrix4d C_all;
-    if (fit(0, &line_all, &C_all)) {
+    Vector6d line_all;
+    Matrix6d C_all;
+    if (fit(0, false, &line_all, &C_all)) {
       // The longer line's estimate is the more precise of two nested ones, so their difference has the
       // covariance C - C_all (Hausman); position and rate both, or two lines through a jump cross.
-      const Eigen::Vector4d d = line - line_all;
-      const Eigen::LLT<Eigen::Matrix4d> llt(C - C_all);
+      const Eigen::Vector4d d = (line - line_all).head<4>();
+      const Eigen::LLT<Eigen::Matrix4d> llt((C - C_all).topLeftCorner<4, 4>());
       if (llt.info() == Eigen::Success && d.dot(llt.solve(d)) < kLateralLinesAgreeChi2)
         line = line_all, C = C_all;
+    }
+  }
+  // Where the whole history accelerates and its parabola fits it (IcpOptions::lateral_acceleration_chi2), the
+  // newest frames' parabola.
+  if (options_.lateral_acceleration_chi2 > 0.0) {
+    Vector6d parabola;
+    Matrix6d C_parabola;
+    if (fit(0, true, &parabola, &C_parabola)) {
+      const Eigen::Vector2d a = parabola.tail<2>();
+      const Eigen::LLT<Eigen::Matrix2d> llt(C_parabola.bottomRightCorner<2, 2>());
+      const double dof = 2.0 * static_cast<double>(lateral_history_.size()) - 6.0;
+      if (llt.info() == Eigen::Success && a.dot(llt.solve(a)) > options_.lateral_acceleration_chi2 &&
+          misfit(0, parabola) < dof + 3.0 * std::sqrt(2.0 * dof) && fit(first, true, &parabola, &C_parabola))
+        line = parabola, C = C_parabola;
     }
   }
   *position_m = line.head<2>();

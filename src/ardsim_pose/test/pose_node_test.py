@@ -131,6 +131,7 @@ class PoseInterfaceTest(unittest.TestCase):
                  ('_icp/contour_consensus_min_depth_m:=-25.0', 'icp/contour_consensus_min_depth_m = -25'),
                  ('_icp/lateral_history_frames:=-1', 'icp/lateral_history_frames = -1'),
                  ('_icp/lateral_gate_frames:=0', 'icp/lateral_gate_frames = 0'),
+                 ('_icp/lateral_acceleration_chi2:=-1.0', 'icp/lateral_acceleration_chi2 = -1'),
                  ('_icp/lateral_line_frames:=2', 'icp/lateral_line_frames = 2'),
                  ('_icp/lateral_line_sigma_m:=-0.001', 'icp/lateral_line_sigma_m = -0.001'),
                  ('_icp/lateral_vote_weight:=-3.0', 'icp/lateral_vote_weight = -3'),

@@ -772,17 +772,22 @@ Eigen::Isometry3d hubbleHoldPath(int k) {
   T.translation() = first + s * (last - first);
   return T;
 }
-// Frame k as rendered: the path, and in frames [jump_first, jump_end) the target 20 mm across the boresight.
-Eigen::Isometry3d hubbleHoldRendered(int k, int jump_first, int jump_end) {
+// Frame k as rendered: the path, in frames [jump_first, jump_end) the target 20 mm across the boresight, and
+// from frame burn_first on accelerating across it at burn_mps2 (a manoeuvre).
+Eigen::Isometry3d hubbleHoldRendered(int k, int jump_first, int jump_end, int burn_first = 0,
+                                     double burn_mps2 = 0.0) {
   Eigen::Isometry3d T = hubbleHoldPath(k);
   if (k >= jump_first && k < jump_end) T.translation().x() += 0.02;
+  const double burn_s = 0.1 * (k - burn_first);
+  if (burn_mps2 != 0.0 && burn_s > 0.0) T.translation().y() += 0.5 * burn_mps2 * burn_s * burn_s;
   return T;
 }
 // The estimates (T_lidar_target) along the path's first `frames` frames, `method: icp` from the truth, noise
 // on (simulator_seed), none of them LOST; with covariances, their covariances too.
 std::vector<Eigen::Isometry3d> hubbleHoldEstimates(
     PoseConfig config, int simulator_seed, int frames, int jump_first = 0, int jump_end = 0,
-    std::vector<Eigen::Matrix<double, 6, 6>>* covariances = nullptr) {
+    std::vector<Eigen::Matrix<double, 6, 6>>* covariances = nullptr, int burn_first = 0,
+    double burn_mps2 = 0.0) {
   config.method = "icp";
   ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, simulator_seed);
   simulator.setTarget(ardsim_description::buildHubble());
@@ -790,7 +795,7 @@ std::vector<Eigen::Isometry3d> hubbleHoldEstimates(
   ardsim_lidar::LidarFrame rendered;
   std::vector<Eigen::Isometry3d> estimates;
   for (int k = 0; k < frames; ++k) {
-    const Eigen::Isometry3d truth = hubbleHoldRendered(k, jump_first, jump_end);
+    const Eigen::Isometry3d truth = hubbleHoldRendered(k, jump_first, jump_end, burn_first, burn_mps2);
     if (k == 0) estimator->setPrior(truth);
     simulator.simulate(truth, static_cast<std::uint64_t>(k), &rendered);
     const EstimatorOutput out = estimator->process(fromLidarFrame(rendered, simulator.rays(), 0.1 * k));
@@ -955,6 +960,39 @@ TEST(HubbleHold, LateralLineHoldsThroughOneFrameAndFollowsAJumpThatLasts) {
   for (int k = 1; k < 4; ++k) EXPECT_LT(lasting.rendered_m[k], 0.0015) << "frame " << 80 + k;   // 0.4-1.1 mm
   for (int k = 6; k < 10; ++k) EXPECT_LT(lasting.rendered_m[k], 0.0015) << "frame " << 80 + k;  // 0.3-0.9 mm
   EXPECT_LT(*std::max_element(lasting.rendered_m.begin() + 1, lasting.rendered_m.end()), 0.008);
+}
+
+// A burn across the boresight (hubble_hold's at 31 m: 0.024 m/s^2, decaying over seconds): the lateral line
+// lags it by ~a T^2 / 12 over its span; the newest frames' parabola, once the history's says it accelerates,
+// does not (IcpOptions::lateral_acceleration_chi2).
+PortError hubbleBurnError(double lateral_acceleration_chi2) {
+  PoseConfig config = hubbleDefaults();
+  config.icp.lateral_acceleration_chi2 = lateral_acceleration_chi2;
+  constexpr int kBurnFirst = 40, kFrames = 90;
+  constexpr double kBurnMps2 = 0.024;
+  const std::vector<Eigen::Isometry3d> estimates =
+      hubbleHoldEstimates(config, 3, kFrames, 0, 0, nullptr, kBurnFirst, kBurnMps2);
+  PortError error;
+  // From the burn's 11th frame on: the first ten are the detection's (the parabola's test needs the history).
+  for (int k = kBurnFirst + 10; k < kFrames; ++k) {
+    const double e = hubblePortErrorM(estimates[k], hubbleHoldRendered(k, 0, 0, kBurnFirst, kBurnMps2));
+    error.rms_m += e * e;
+    error.worst_m = std::max(error.worst_m, e);
+  }
+  error.rms_m = std::sqrt(error.rms_m / (kFrames - kBurnFirst - 10));
+  return error;
+}
+
+TEST(HubbleHold, ParabolaFollowsABurnTheLineLags) {
+  const PortError parabola = hubbleBurnError(hubbleDefaults().icp.lateral_acceleration_chi2),
+                  lines = hubbleBurnError(0.0);
+  std::printf(
+      "a 0.024 m/s^2 burn across the boresight, its frames 11-50: port RMS / worst %.2f / %.2f mm "
+      "(lines only: %.2f / %.2f mm)\n",
+      parabola.rms_m * 1e3, parabola.worst_m * 1e3, lines.rms_m * 1e3, lines.worst_m * 1e3);
+  ASSERT_GT(hubbleDefaults().icp.lateral_acceleration_chi2, 0.0);
+  EXPECT_LT(parabola.rms_m, 0.7 * lines.rms_m);
+  EXPECT_LT(parabola.worst_m, lines.worst_m);
 }
 
 }  // namespace

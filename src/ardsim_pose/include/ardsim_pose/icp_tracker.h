@@ -106,6 +106,12 @@ struct IcpOptions {
   // within 0.7 mm of the truth, 3.55 / 3.47 -> 2.92 / 3.11 mm); two in a row are a manoeuvre. 1: the line
   // is dropped at the first.
   int lateral_gate_frames = 2;
+  // ... and where the parabola through the whole history says it accelerates (the chi^2 of its acceleration,
+  // 2 degrees of freedom, above this) and fits it (its own chi^2 within 3 sigma of its degrees of freedom:
+  // a jump is the gate's), the parabola through the newest lateral_line_frames instead: a line lags a steady
+  // acceleration a by ~a T^2 / 12 over its span T (hubble_hold's burn at 31 m, 0.024 m/s^2 across the
+  // boresight: the 10 frames' line 2-3 mm behind for seconds). 0: lines only.
+  double lateral_acceleration_chi2 = 9.0;
   // ... and that line's prediction breaks the vote's near-ties too: a translation there loses
   // lateral_vote_weight / 2 votes per unit of its squared distance from the prediction, in sigmas of the
   // prediction widened by one vote cell (OccludingContours::VotePrior). The vote's top is a plateau a few
