@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -454,28 +455,42 @@ bool IcpTracker::lateralPrior(double stamp_s, Eigen::Vector2d* position_m,
   // the unknowns (p, v[, a]) in the first 4 [6] of line and C.
   using Vector6d = Eigen::Matrix<double, 6, 1>;
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  auto design = [&](const LateralMeasurement& m) {
+    const double dt = m.stamp_s - stamp_s;
+    Eigen::Matrix<double, 2, 6> J;
+    J << Eigen::Matrix2d::Identity(), dt * Eigen::Matrix2d::Identity(),
+        0.5 * dt * dt * Eigen::Matrix2d::Identity();
+    return J;
+  };
+  // Fixed-size inverses: this runs in every alignment iteration of a frame with the consensus.
+  auto invert = [](const auto& N, auto* C) {
+    const Eigen::FullPivLU<std::decay_t<decltype(N)>> lu(N);
+    if (!lu.isInvertible()) return false;
+    *C = lu.inverse();
+    return true;
+  };
   auto fit = [&](std::size_t first, bool accelerating, Vector6d* line, Matrix6d* C) {
-    const int n = accelerating ? 6 : 4;
     if (lateral_history_.size() - first < (accelerating ? 4u : 3u)) return false;
     Matrix6d N = Matrix6d::Zero();
     Vector6d b = Vector6d::Zero();
     for (std::size_t k = first; k < lateral_history_.size(); ++k) {
       const LateralMeasurement& m = lateral_history_[k];
-      const double dt = m.stamp_s - stamp_s;
-      Eigen::Matrix<double, 2, 6> J = Eigen::Matrix<double, 2, 6>::Zero();
-      J.leftCols<2>().setIdentity();
-      J.middleCols<2>(2) = dt * Eigen::Matrix2d::Identity();
-      J.rightCols<2>() = 0.5 * dt * dt * Eigen::Matrix2d::Identity();
+      const Eigen::Matrix<double, 2, 6> J = design(m);
       const Eigen::Matrix2d W = m.covariance_m2.inverse();
       N += J.transpose() * W * J;
       b += J.transpose() * W * m.position_m;
     }
-    const Eigen::FullPivLU<Eigen::MatrixXd> lu(N.topLeftCorner(n, n));
-    if (!lu.isInvertible()) return false;
     C->setZero();
     line->setZero();
-    C->topLeftCorner(n, n) = lu.inverse();
-    line->head(n) = C->topLeftCorner(n, n) * b.head(n);
+    if (accelerating) {
+      if (!invert(N, C)) return false;
+      *line = *C * b;
+    } else {
+      Eigen::Matrix4d C_line;
+      if (!invert(Eigen::Matrix4d(N.topLeftCorner<4, 4>()), &C_line)) return false;
+      C->topLeftCorner<4, 4>() = C_line;
+      line->head<4>() = C_line * b.head<4>();
+    }
     return line->allFinite() && C->allFinite();
   };
   // The fit's chi^2 over the frames from first on.
@@ -483,9 +498,7 @@ bool IcpTracker::lateralPrior(double stamp_s, Eigen::Vector2d* position_m,
     double chi2 = 0.0;
     for (std::size_t k = first; k < lateral_history_.size(); ++k) {
       const LateralMeasurement& m = lateral_history_[k];
-      const double dt = m.stamp_s - stamp_s;
-      const Eigen::Vector2d r =
-          m.position_m - line.head<2>() - dt * line.segment<2>(2) - 0.5 * dt * dt * line.tail<2>();
+      const Eigen::Vector2d r = m.position_m - design(m) * line;
       chi2 += r.dot(m.covariance_m2.ldlt().solve(r));
     }
     return chi2;

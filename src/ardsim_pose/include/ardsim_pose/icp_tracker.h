@@ -443,8 +443,9 @@ class IcpTracker : public PoseMethod {
     lateral_history_.clear();
     lateral_disagreeing_frames_ = 0;
   }
-  // The history's weighted straight line at stamp_s (IcpOptions::lateral_line_frames, lateral_line_sigma_m):
-  // the position and its covariance (false: fewer than three measurements, or no spread in time).
+  // The history's weighted straight line at stamp_s (IcpOptions::lateral_line_frames, lateral_line_sigma_m),
+  // or its parabola where it accelerates (lateral_acceleration_chi2): the position and its covariance (false:
+  // fewer than three measurements, or no spread in time).
   bool lateralPrior(double stamp_s, Eigen::Vector2d* position_m, Eigen::Matrix2d* covariance_m2) const;
 };
 
