@@ -772,22 +772,27 @@ Eigen::Isometry3d hubbleHoldPath(int k) {
   T.translation() = first + s * (last - first);
   return T;
 }
-// Frame k as rendered: the path, in frames [jump_first, jump_end) the target 20 mm across the boresight, and
-// from frame burn_first on accelerating across it at burn_mps2 (a manoeuvre).
-Eigen::Isometry3d hubbleHoldRendered(int k, int jump_first, int jump_end, int burn_first = 0,
-                                     double burn_mps2 = 0.0) {
+// What the target does on top of the path: in frames [jump_first, jump_end) it is 20 mm across the boresight,
+// and from frame burn_first on it accelerates across it at burn_mps2 (a manoeuvre).
+struct HubbleHoldMotion {
+  int jump_first = 0, jump_end = 0;
+  int burn_first = 0;
+  double burn_mps2 = 0.0;
+};
+// Frame k as rendered.
+Eigen::Isometry3d hubbleHoldRendered(int k, const HubbleHoldMotion& motion) {
   Eigen::Isometry3d T = hubbleHoldPath(k);
-  if (k >= jump_first && k < jump_end) T.translation().x() += 0.02;
-  const double burn_s = 0.1 * (k - burn_first);
-  if (burn_mps2 != 0.0 && burn_s > 0.0) T.translation().y() += 0.5 * burn_mps2 * burn_s * burn_s;
+  if (k >= motion.jump_first && k < motion.jump_end) T.translation().x() += 0.02;
+  const double burn_s = 0.1 * (k - motion.burn_first);
+  if (motion.burn_mps2 != 0.0 && burn_s > 0.0)
+    T.translation().y() += 0.5 * motion.burn_mps2 * burn_s * burn_s;
   return T;
 }
 // The estimates (T_lidar_target) along the path's first `frames` frames, `method: icp` from the truth, noise
 // on (simulator_seed), none of them LOST; with covariances, their covariances too.
 std::vector<Eigen::Isometry3d> hubbleHoldEstimates(
-    PoseConfig config, int simulator_seed, int frames, int jump_first = 0, int jump_end = 0,
-    std::vector<Eigen::Matrix<double, 6, 6>>* covariances = nullptr, int burn_first = 0,
-    double burn_mps2 = 0.0) {
+    PoseConfig config, int simulator_seed, int frames, const HubbleHoldMotion& motion = {},
+    std::vector<Eigen::Matrix<double, 6, 6>>* covariances = nullptr) {
   config.method = "icp";
   ardsim_lidar::LidarSimulator simulator(config.sensor, ardsim_lidar::NoiseOptions{}, simulator_seed);
   simulator.setTarget(ardsim_description::buildHubble());
@@ -795,7 +800,7 @@ std::vector<Eigen::Isometry3d> hubbleHoldEstimates(
   ardsim_lidar::LidarFrame rendered;
   std::vector<Eigen::Isometry3d> estimates;
   for (int k = 0; k < frames; ++k) {
-    const Eigen::Isometry3d truth = hubbleHoldRendered(k, jump_first, jump_end, burn_first, burn_mps2);
+    const Eigen::Isometry3d truth = hubbleHoldRendered(k, motion);
     if (k == 0) estimator->setPrior(truth);
     simulator.simulate(truth, static_cast<std::uint64_t>(k), &rendered);
     const EstimatorOutput out = estimator->process(fromLidarFrame(rendered, simulator.rays(), 0.1 * k));
@@ -813,24 +818,26 @@ struct PortError {
   double rms_m = 0.0;
   double worst_m = 0.0;
 };
+// The port position error of estimates[first, end) against the frames as rendered.
+PortError hubblePortError(const std::vector<Eigen::Isometry3d>& estimates, int first, int end,
+                          const HubbleHoldMotion& motion = {}) {
+  PortError error;
+  for (int k = first; k < end; ++k) {
+    const double e = hubblePortErrorM(estimates[k], hubbleHoldRendered(k, motion));
+    error.rms_m += e * e;
+    error.worst_m = std::max(error.worst_m, e);
+  }
+  error.rms_m = std::sqrt(error.rms_m / (end - first));
+  return error;
+}
 PortError hubbleLateralError(int lateral_history_frames, double lateral_vote_weight, int simulator_seed = 3,
                              int lateral_gate_frames = 0 /* 0: the default */) {
   PoseConfig config = hubbleDefaults();
   config.icp.lateral_history_frames = lateral_history_frames;
   config.icp.lateral_vote_weight = lateral_vote_weight;
   if (lateral_gate_frames > 0) config.icp.lateral_gate_frames = lateral_gate_frames;
-  const std::vector<Eigen::Isometry3d> estimates =
-      hubbleHoldEstimates(config, simulator_seed, kHubbleHoldPathFrames);
-  PortError error;
-  int count = 0;
-  for (int k = 20; k < kHubbleHoldPathFrames; ++k) {
-    const double e = hubblePortErrorM(estimates[k], hubbleHoldPath(k));
-    error.rms_m += e * e;
-    error.worst_m = std::max(error.worst_m, e);
-    ++count;
-  }
-  error.rms_m = std::sqrt(error.rms_m / count);
-  return error;
+  return hubblePortError(hubbleHoldEstimates(config, simulator_seed, kHubbleHoldPathFrames), 20,
+                         kHubbleHoldPathFrames);
 }
 
 // At 47 m each frame's own measurement is weak (its polygon widened by 0.02 px: ~1.3 mm), the newest ten
@@ -865,7 +872,7 @@ TEST(HubbleHold, LateralHistoryPlacesTheRimBetterThanEachFrameAlone) {
 TEST(HubbleHold, CovarianceSaysHowWellTheRimIsPlacedAcrossTheBoresight) {
   std::vector<Eigen::Matrix<double, 6, 6>> covariances;
   const std::vector<Eigen::Isometry3d> estimates =
-      hubbleHoldEstimates(hubbleDefaults(), 3, kHubbleHoldPathFrames, 0, 0, &covariances);
+      hubbleHoldEstimates(hubbleDefaults(), 3, kHubbleHoldPathFrames, {}, &covariances);
   const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
   double z_sq = 0.0, sigma_sq = 0.0, error_sq = 0.0;
   int count = 0;
@@ -927,13 +934,14 @@ JumpErrors hubbleErrorsAfterJump(int lateral_gate_frames, int jump_frames) {
   PoseConfig config = hubbleDefaults();
   config.icp.lateral_gate_frames = lateral_gate_frames;
   constexpr int kJumpFrame = 80, kFrames = 90;
-  const std::vector<Eigen::Isometry3d> estimates =
-      hubbleHoldEstimates(config, 3, kFrames, kJumpFrame, kJumpFrame + jump_frames);
+  HubbleHoldMotion jump;
+  jump.jump_first = kJumpFrame;
+  jump.jump_end = kJumpFrame + jump_frames;
+  const std::vector<Eigen::Isometry3d> estimates = hubbleHoldEstimates(config, 3, kFrames, jump);
   JumpErrors errors;
   for (int k = kJumpFrame; k < kFrames; ++k) {
     errors.path_m.push_back(hubblePortErrorM(estimates[k], hubbleHoldPath(k)));
-    errors.rendered_m.push_back(
-        hubblePortErrorM(estimates[k], hubbleHoldRendered(k, kJumpFrame, kJumpFrame + jump_frames)));
+    errors.rendered_m.push_back(hubblePortErrorM(estimates[k], hubbleHoldRendered(k, jump)));
   }
   return errors;
 }
@@ -968,19 +976,12 @@ TEST(HubbleHold, LateralLineHoldsThroughOneFrameAndFollowsAJumpThatLasts) {
 PortError hubbleBurnError(double lateral_acceleration_chi2) {
   PoseConfig config = hubbleDefaults();
   config.icp.lateral_acceleration_chi2 = lateral_acceleration_chi2;
-  constexpr int kBurnFirst = 40, kFrames = 90;
-  constexpr double kBurnMps2 = 0.024;
-  const std::vector<Eigen::Isometry3d> estimates =
-      hubbleHoldEstimates(config, 3, kFrames, 0, 0, nullptr, kBurnFirst, kBurnMps2);
-  PortError error;
+  constexpr int kFrames = 90;
+  HubbleHoldMotion burn;
+  burn.burn_first = 40;
+  burn.burn_mps2 = 0.024;
   // From the burn's 11th frame on: the first ten are the detection's (the parabola's test needs the history).
-  for (int k = kBurnFirst + 10; k < kFrames; ++k) {
-    const double e = hubblePortErrorM(estimates[k], hubbleHoldRendered(k, 0, 0, kBurnFirst, kBurnMps2));
-    error.rms_m += e * e;
-    error.worst_m = std::max(error.worst_m, e);
-  }
-  error.rms_m = std::sqrt(error.rms_m / (kFrames - kBurnFirst - 10));
-  return error;
+  return hubblePortError(hubbleHoldEstimates(config, 3, kFrames, burn), burn.burn_first + 10, kFrames, burn);
 }
 
 TEST(HubbleHold, ParabolaFollowsABurnTheLineLags) {
