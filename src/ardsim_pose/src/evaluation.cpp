@@ -22,14 +22,9 @@ PoseErrorValue poseError(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d
 
 NormalizedError normalizedError(const PoseErrorValue& error, const Eigen::Matrix<double, 6, 6>& covariance,
                                 const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_target_port) {
-  // The port moves with the origin's translation and, for a rotation w (lidar frame, left), by w x lever
-  // = -skew(lever) w.
   const Eigen::Vector3d lever = T_est.linear() * T_target_port.translation();
-  Eigen::Matrix<double, 3, 6> J;
-  J.leftCols<3>().setIdentity();
-  J.rightCols<3>() = -skew(lever);
   NormalizedError n;
-  n.port_sigma_m = (J * covariance * J.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
+  n.port_sigma_m = covarianceAt(covariance, lever).diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
   n.attitude_sigma_rad = covariance.bottomRightCorner<3, 3>().diagonal().cwiseMax(0.0).cwiseSqrt();
   for (int i = 0; i < 3; ++i) {
     if (n.port_sigma_m(i) > 0.0) n.port_position(i) = error.port_position_error_m(i) / n.port_sigma_m(i);

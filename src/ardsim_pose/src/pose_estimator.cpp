@@ -91,8 +91,24 @@ void PoseEstimator::compose(const PoseResult& icp, const PoseResult& ring, PoseR
   const Eigen::Matrix3d R = rotationOf(Eigen::Vector3d(turn.x(), turn.y(), icp_roll ? turn.z() : 0.0)) *
                             result->T_lidar_target.linear();
   const Eigen::Vector3d port_m = ring.T_lidar_target * T_target_port_.translation();
+  // The covariance the same way, at the port: its position the ring's, the tilt (and the roll where taken)
+  // ICP's; then moved to the origin (PoseResult::covariance). As the ring's alone it said the ring's tilt
+  // where ICP's was taken.
+  Eigen::Matrix<double, 6, 6> port_cov = Eigen::Matrix<double, 6, 6>::Zero();
+  port_cov.topLeftCorner<3, 3>() =
+      covarianceAt(ring.covariance, ring.T_lidar_target.linear() * T_target_port_.translation())
+          .topLeftCorner<3, 3>();
+  Eigen::Matrix3d rotation_cov = icp.covariance.bottomRightCorner<3, 3>();
+  if (!icp_roll) {
+    const double roll_variance = result->covariance(5, 5);
+    rotation_cov.row(2).setZero();
+    rotation_cov.col(2).setZero();
+    rotation_cov(2, 2) = roll_variance;
+  }
+  port_cov.bottomRightCorner<3, 3>() = rotation_cov;
   result->T_lidar_target.linear() = R;
   result->T_lidar_target.translation() = port_m - R * T_target_port_.translation();
+  result->covariance = covarianceAt(port_cov, -(R * T_target_port_.translation()));
   if (icp_roll) {
     // The roll is ICP's, and so is whether it was observed or held near its prediction: the prediction
     // learns no roll rate from a held roll (with the ring's flags it learnt one from ICP's held roll, and the

@@ -71,6 +71,22 @@ TEST(NormalizedError, PortSigmaThroughTheLeverAndErrorsOverSigmas) {
   EXPECT_EQ(z.attitude_sigma_rad.z(), 0.0);
 }
 
+// A method that measures the port moves its covariance to the origin (PoseResult::covariance's point) and
+// normalizedError moves it back: the port's comes out as it went in, however large the lever makes the
+// origin's (a roll sigma of pi, unobserved, 4.5 m off the axis).
+TEST(CovarianceAt, MovedToTheOriginAndBackIsThePorts) {
+  Eigen::Matrix<double, 6, 6> port = Eigen::Matrix<double, 6, 6>::Zero();
+  port.diagonal() << 1e-8, 4e-8, 1e-8, 1e-8, 1e-8, M_PI * M_PI;
+  port(0, 1) = port(1, 0) = 1e-8;
+  const Eigen::Vector3d lever(-4.5, 0.3, 14.5);  // port -> origin
+  const Eigen::Matrix<double, 6, 6> origin = covarianceAt(port, lever);
+  EXPECT_GT(origin(1, 1), 100.0);  // a roll w about z moves it by w x lever: y by 4.5 m times w
+  const Eigen::Matrix3d origin_rotation = origin.bottomRightCorner<3, 3>(),
+                        port_rotation = port.bottomRightCorner<3, 3>();
+  EXPECT_EQ(origin_rotation, port_rotation);  // the rotation's block stays
+  EXPECT_LT((covarianceAt(origin, -lever) - port).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 TEST(IsReturn, FiniteAndInFrontOnly) {
   const float inf = std::numeric_limits<float>::infinity();
   const float nan = std::numeric_limits<float>::quiet_NaN();

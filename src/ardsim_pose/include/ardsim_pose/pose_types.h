@@ -26,6 +26,17 @@ inline Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return m;
 }
 
+// A pose covariance (x y z, rot x y z; the rotation in lidar axes, on the left) moved from the point it is of
+// to one `offset` from it (lidar axes): that point moves with the translation and, for a rotation w, by
+// w x offset = -skew(offset) w. The rotation's block stays. PoseResult::covariance is the target origin's;
+// a method that measures the port gives the port's and moves it by minus the lever (origin - port).
+inline Eigen::Matrix<double, 6, 6> covarianceAt(const Eigen::Matrix<double, 6, 6>& covariance,
+                                                const Eigen::Vector3d& offset) {
+  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
+  J.topRightCorner<3, 3>() = -skew(offset);
+  return J * covariance * J.transpose();
+}
+
 // Whether a point of such a frame is a return: finite and in front of the sensor. (z first: most pixels of
 // a far target's frame have none, and the test runs on every pixel of every frame. Then one test for all
 // three finite: v - v is 0 for a finite v and NaN for an infinite or NaN one.)

@@ -824,7 +824,10 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   result.iterations = 2;
 
   // Covariance of the port's pose, in lidar axes (x y z, rot x y z): lateral from the circle / cross fit,
-  // along the normal and the two tilts from the plane fit, the boresight angle from whether it was observed.
+  // along the normal and the two tilts from the plane fit, the boresight angle from whether it was observed;
+  // then moved to the target origin, as PoseResult::covariance is (as the port's, the origin's said the
+  // port's position where its roll and tilt move the origin: the ISS's 4.5 m off the docking axis, 39 mm on
+  // lidar x from a 0.5 deg roll sigma).
   const double plane_sigma =
       std::max(r.report.plane_rms_m, 1e-4) / std::sqrt(static_cast<double>(r.report.plane_points));
   Eigen::Matrix3d position_cov = plane_sigma * plane_sigma * r.n * r.n.transpose();
@@ -835,9 +838,11 @@ PoseResult AdapterFitter::fit(const PreparedFrame& frame, const std::vector<int>
   const double spin_sigma = result.boresight_rotation_observed ? 0.5 * kDeg : M_PI;
   const Eigen::Matrix3d rotation_cov =
       tilt_sigma * tilt_sigma * (E * E.transpose()) + spin_sigma * spin_sigma * r.n * r.n.transpose();
-  result.covariance.setZero();
-  result.covariance.topLeftCorner<3, 3>() = position_cov;
-  result.covariance.bottomRightCorner<3, 3>() = rotation_cov;
+  Eigen::Matrix<double, 6, 6> port_cov = Eigen::Matrix<double, 6, 6>::Zero();
+  port_cov.topLeftCorner<3, 3>() = position_cov;
+  port_cov.bottomRightCorner<3, 3>() = rotation_cov;
+  result.covariance =
+      covarianceAt(port_cov, -(result.T_lidar_target.linear() * g.T_target_port.translation()));
 
   // 8. A pose far from the prediction is more likely a wrong detection than a real jump between frames.
   const Eigen::Vector3d jump = T_lidar_port.translation() - T_lidar_port_prior.translation();

@@ -8,8 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include "ardsim_description/frames.h"
 #include "ardsim_pose/close_range/pyramid.h"
 #include "ardsim_pose/close_range/ring_detector.h"
+#include "ardsim_pose/evaluation.h"
 #include "rendering.h"
 
 namespace ardsim_pose {
@@ -245,6 +247,49 @@ TEST_P(CloseRangeHubble, FromTheHandOverToOneAndAHalfMetres) {
   EXPECT_LE(roll_max_deg, 1.0);
   EXPECT_GE(observed, index / 2);
 }
+
+// The published covariance is the target origin's (PoseResult::covariance): through the lever to the port it
+// must say how far off the port is. The methods measure the port; as the port's, labelled the origin's, the
+// ISS's said 39 mm across the boresight where the port was 0.3 mm off (its origin 4.5 m off the docking axis,
+// times the roll's 0.5 deg sigma): z 0.02. RMS of each error over its sigma, noise on, 7 to 3 m, tilts and
+// lateral offsets as in the closed loop (0.5 deg, 1 cm).
+class CloseRangeCovariance : public ::testing::TestWithParam<EstimateMethod> {};
+
+TEST_P(CloseRangeCovariance, SaysHowFarOffThePortIs) {
+  TargetRenderer renderer(true);
+  std::unique_ptr<PoseMethod> estimator = makeMethod(GetParam(), true);
+  const Eigen::Isometry3d T_target_port =
+      ardsim_description::T_target_port(ardsim_description::TargetKind::kIss);
+  double lateral_sq = 0.0, range_sq = 0.0, tilt_sq = 0.0;
+  int frames = 0, index = 0;
+  for (const double range : {7.0, 6.0, 5.0, 4.0, 3.0}) {
+    for (int variant = 0; variant < 4; ++variant, ++index) {
+      const ApproachState s = disturbedState(range, index, 0.5, 0.01);
+      const Eigen::Isometry3d truth = testing::T_lidar_target(s);
+      const PoseResult result = estimator->estimate(renderer.render(truth, index), predictionFrom(s));
+      if (result.status == EstimateStatus::kLost) continue;
+      const NormalizedError z = normalizedError(poseError(result.T_lidar_target, truth, T_target_port),
+                                                result.covariance, result.T_lidar_target, T_target_port);
+      lateral_sq += z.port_position.head<2>().squaredNorm();
+      range_sq += z.port_position.z() * z.port_position.z();
+      tilt_sq += z.attitude.head<2>().squaredNorm();
+      ++frames;
+    }
+  }
+  ASSERT_GT(frames, 0);
+  const double z_lat = std::sqrt(lateral_sq / (2 * frames)), z_rng = std::sqrt(range_sq / frames),
+               z_tilt = std::sqrt(tilt_sq / (2 * frames));
+  std::printf("%s: %d frames, error over sigma RMS: across the boresight %.2f, along it %.2f, tilt %.2f\n",
+              name(GetParam()), frames, z_lat, z_rng, z_tilt);
+  // Across the boresight within 3x either way (measured: ring 1.65, pyramid 1.61). Along it and in tilt the
+  // fits' sigmas are the noise's alone, without the frames' systematic errors: measured ring 3.93 / 2.34,
+  // pyramid 1.02 / 1.06 here (the default scenario's closed loop at 3-10 m: ~1 on every axis).
+  EXPECT_GT(z_lat, 1.0 / 3.0);
+  EXPECT_LT(z_lat, 3.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, CloseRangeCovariance,
+                         ::testing::Values(EstimateMethod::kRing, EstimateMethod::kPyramid));
 
 INSTANTIATE_TEST_SUITE_P(Methods, CloseRangeHubble,
                          ::testing::Values(EstimateMethod::kRing, EstimateMethod::kPyramid));
