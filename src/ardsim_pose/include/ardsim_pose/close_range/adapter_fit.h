@@ -104,8 +104,11 @@ Eigen::Matrix3d portRotation(const Eigen::Vector3d& normal, double boresight_rad
 
 // What the fits found, for tests and diagnostics.
 struct AdapterFitReport {
-  bool circle = false;       // the ring's inner edge (and outer when seen) fitted
-  bool cross = false;        // the centreline cross seen well enough for the lateral position
+  bool circle = false;  // the ring's inner edge (and outer when seen) fitted
+  bool cross = false;   // the centreline cross seen well enough for the lateral position
+  // The field of view cuts the inner edge's circle: where the cross is seen, the lateral position is the
+  // cross's alone (the circle's arc biased).
+  bool circle_clipped = false;
   bool petals = false;       // boresight angle measured from the petals
   bool cross_angle = false;  // boresight angle measured from the cross
   bool reflectors = false;   // boresight angle measured from the peripheral reflector targets
