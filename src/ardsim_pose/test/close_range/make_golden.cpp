@@ -1,9 +1,8 @@
 // Regenerates the close-range golden set (golden_io.h) into DIR:
 //   devel/lib/ardsim_pose/pose_close_range_make_golden [--estimates-only]
 //   src/ardsim_pose/test/close_range/golden
-// --estimates-only: the expected estimates of the frames already there (after a change to the methods; the
-// frames rendered again differ from the committed ones in the last millimetre wherever llvmpipe's build or
-// the CPU differ).
+// --estimates-only: the expected estimates of the frames already there (after a change to the methods: the
+// frames rendered again now are other noise draws than the committed ones, a median 10 mm a pixel apart).
 // Frames: the ISS docking adapter rendered with noise on (seed 7) along golden::goldenRanges(); expected
 // estimates of the ring and pyramid methods, each frame predicted from its truth disturbed
 // (golden::goldenPrediction).
