@@ -102,6 +102,17 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
       rms(a));
 }
 
+// Hubble in `auto` with its target defaults over the sweep, rendered with noise (renderer_seed).
+void runHubbleAuto(std::uint64_t renderer_seed, const Sweep& sweep, std::vector<SweepFrame>* run) {
+  testing::TargetRenderer renderer(true, renderer_seed, TargetKind::kHubble);
+  PoseConfig config;
+  config.target = TargetKind::kHubble;
+  applyTargetDefaults(&config);
+  config.method = "auto";
+  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
+  runSweep(sweep, &renderer, estimator.get(), run);
+}
+
 // Hubble in auto from 28 m through the hand-over at 20 m to 18.4 m (port to port; 0.2 m a 0.1 s frame),
 // tilted, offset and rolled a little, from an acquisition at the first frame: ICP's pose to 20 m (its
 // lateral position from the face-on bulkhead's rim: the occluding contours, by consensus from 25 m out),
@@ -109,16 +120,10 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
 // (the ring alone tilts ~0.05 deg). Until session 37 the composite began at 30 m: port position RMS 1.9 mm,
 // worst 4.0 mm here; since, 1.0 / 2.9 mm.
 TEST(CloseRangeHandover, HubbleCompositePortFromTheRingTiltFromIcp) {
-  testing::TargetRenderer renderer(true, 13, TargetKind::kHubble);
-  PoseConfig config;
-  config.target = TargetKind::kHubble;
-  applyTargetDefaults(&config);
-  config.method = "auto";
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
   const Sweep sweep{
       {28.0, 0.12, -0.06, 0.8, -0.5, 3.0}, {-0.2, -0.002, 0.0, -0.016, 0.012, 0.0}, 49, TargetKind::kHubble};
   std::vector<SweepFrame> run;
-  ASSERT_NO_FATAL_FAILURE(runSweep(sweep, &renderer, estimator.get(), &run));
+  ASSERT_NO_FATAL_FAILURE(runHubbleAuto(13, sweep, &run));
   std::vector<double> position_error, tilt_error;
   double position_max_m = 0.0;
   for (const SweepFrame& f : run) {
@@ -140,16 +145,10 @@ TEST(CloseRangeHandover, HubbleCompositePortFromTheRingTiltFromIcp) {
 // tilt's error over its sigma was 0.34 on the Hubble dataset at 10-20 m (evaluate_dataset --method auto).
 // Hubble from 16 to 11.5 m port to port, the composite throughout.
 TEST(CloseRangeHandover, HubbleCompositeCovarianceIsItsParts) {
-  testing::TargetRenderer renderer(true, 17, TargetKind::kHubble);
-  PoseConfig config;
-  config.target = TargetKind::kHubble;
-  applyTargetDefaults(&config);
-  config.method = "auto";
-  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
   const Sweep sweep{
       {16.0, 0.05, -0.03, 0.6, -0.4, 2.0}, {-0.15, -0.001, 0.001, -0.01, 0.01, 0.0}, 31, TargetKind::kHubble};
   std::vector<SweepFrame> run;
-  ASSERT_NO_FATAL_FAILURE(runSweep(sweep, &renderer, estimator.get(), &run));
+  ASSERT_NO_FATAL_FAILURE(runHubbleAuto(17, sweep, &run));
   const Eigen::Isometry3d T_target_port = ardsim_description::T_target_port(TargetKind::kHubble);
   std::vector<double> z_lateral, z_tilt;
   for (std::size_t k = 1; k < run.size(); ++k) {  // the first frame is the acquisition's
@@ -162,8 +161,8 @@ TEST(CloseRangeHandover, HubbleCompositeCovarianceIsItsParts) {
   }
   std::printf("the composite's %zu frames: error over sigma RMS across the boresight %.2f, tilt %.2f\n",
               z_tilt.size() / 2, rms(z_lateral), rms(z_tilt));
-  for (const double z :
-       {rms(z_lateral), rms(z_tilt)}) {  // measured 1.18 / 0.95 (the ring's whole: 1.17 / 0.33)
+  // Measured 1.18 / 0.95 (the ring's whole: 1.17 / 0.33).
+  for (const double z : {rms(z_lateral), rms(z_tilt)}) {
     EXPECT_GT(z, 0.5);
     EXPECT_LT(z, 2.0);
   }
