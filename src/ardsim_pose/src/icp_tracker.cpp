@@ -1250,13 +1250,11 @@ PoseResult IcpTracker::processFrame(const OrganizedCloud& cloud, const Eigen::Is
   const double dof = std::max(1.0, weight_sum - 6.0);
   const double variance = std::max(weighted_sq_sum / dof, options_.min_sigma_m * options_.min_sigma_m);
   const double robust_sigma_m = a.limit_m / options_.tukey_c;
-  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Identity();
-  A.block<3, 3>(0, 3) = -skew(T.translation() - centre);
   Eigen::Matrix<double, 6, 6> H_posterior = H + (variance / (robust_sigma_m * robust_sigma_m)) * a.H_lateral;
   if (a.boresight_prior_rad > 0.0)
     H_posterior(5, 5) += variance / (a.boresight_prior_rad * a.boresight_prior_rad);
-  result.covariance =
-      A * (variance * H_posterior.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity())) * A.transpose();
+  result.covariance = covarianceAt(
+      variance * H_posterior.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity()), T.translation() - centre);
 
   // Condition of the lever-scaled normal equations.
   const Eigen::Matrix<double, 6, 6> H_scaled = leverScaled(H, centre);
