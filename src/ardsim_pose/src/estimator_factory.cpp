@@ -168,8 +168,14 @@ std::unique_ptr<PoseEstimator> makeEstimator(const PoseConfig& config,
   }
   methods[EstimateMethod::kIcp] = std::move(icp);
   const close_range::AdapterGeometry geometry = close_range::adapterGeometry(config.target);
-  methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, config.ring);
-  methods[EstimateMethod::kPyramid] = std::make_unique<close_range::PyramidMethod>(geometry, config.pyramid);
+  // The close-range fits' pixel size is the sensor's (AdapterFitOptions' default is the default sensor's:
+  // with another, their pixel-scaled thresholds and the field of view they test were another sensor's).
+  const double pixel_pitch_rad = config.sensor.fov_deg * M_PI / 180.0 / config.sensor.width;
+  close_range::RingDetectorOptions ring = config.ring;
+  close_range::PyramidOptions pyramid = config.pyramid;
+  ring.fit.pixel_pitch_rad = pyramid.fit.pixel_pitch_rad = pixel_pitch_rad;
+  methods[EstimateMethod::kRing] = std::make_unique<close_range::RingMethod>(geometry, ring);
+  methods[EstimateMethod::kPyramid] = std::make_unique<close_range::PyramidMethod>(geometry, pyramid);
   std::unique_ptr<MethodSelector> selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp);
   if (config.method == "ring") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kRing);
   if (config.method == "pyramid") selector = std::make_unique<FixedMethodSelector>(EstimateMethod::kPyramid);

@@ -45,11 +45,11 @@ inline Eigen::Isometry3d T_lidar_target(
 class TargetRenderer {
  public:
   explicit TargetRenderer(bool noise, std::uint64_t seed = 7,
-                          ardsim_description::TargetKind kind = ardsim_description::TargetKind::kIss) {
+                          ardsim_description::TargetKind kind = ardsim_description::TargetKind::kIss,
+                          const ardsim_lidar::SensorOptions& sensor = {}) {
     ardsim_lidar::NoiseOptions noise_options;
     noise_options.enabled = noise;
-    simulator_ =
-        std::make_unique<ardsim_lidar::LidarSimulator>(ardsim_lidar::SensorOptions{}, noise_options, seed);
+    simulator_ = std::make_unique<ardsim_lidar::LidarSimulator>(sensor, noise_options, seed);
     simulator_->setTarget(ardsim_description::buildTarget(kind));
   }
 

@@ -102,6 +102,31 @@ TEST(CloseRangeHandover, FromIcpWithoutJumpOrLostFrame) {
       rms(a));
 }
 
+// The close-range methods take the configured sensor's pixel size: a 128 x 128 sensor (pixels twice as wide
+// as the default's) from 6 m to 1.5 m port to port, `method: ring`, noise on, within the close-range goals.
+TEST(CloseRangeSensor, ALowerResolutionSensorsPixels) {
+  ardsim_lidar::SensorOptions sensor;
+  sensor.width = sensor.height = 128;
+  testing::TargetRenderer renderer(true, 7, TargetKind::kIss, sensor);
+  PoseConfig config;
+  config.sensor = sensor;
+  config.method = "ring";
+  std::unique_ptr<PoseEstimator> estimator = makeEstimator(config);
+  const Sweep sweep{{6.0, 0.01, -0.01, 0.3, -0.2, 2.0}, {-0.1, 0.0, 0.0, 0.0, 0.0, 0.0}, 46};
+  std::vector<SweepFrame> run;
+  ASSERT_NO_FATAL_FAILURE(runSweep(sweep, &renderer, estimator.get(), &run));
+  double lateral_max_m = 0.0, range_max_m = 0.0;
+  for (const SweepFrame& f : run) {
+    const testing::PortError e = testing::portError(f.result.T_lidar_target, f.truth);
+    lateral_max_m = std::max(lateral_max_m, e.lateral());
+    range_max_m = std::max(range_max_m, std::abs(e.range_m));
+  }
+  std::printf("128 x 128, 6-1.5 m, ring: lateral max %.2f mm, range max %.2f mm\n", lateral_max_m * 1e3,
+              range_max_m * 1e3);
+  EXPECT_LT(lateral_max_m, 0.02);
+  EXPECT_LT(range_max_m, 0.01);
+}
+
 // Hubble in `auto` with its target defaults over the sweep, rendered with noise (renderer_seed).
 void runHubbleAuto(std::uint64_t renderer_seed, const Sweep& sweep, std::vector<SweepFrame>* run) {
   testing::TargetRenderer renderer(true, renderer_seed, TargetKind::kHubble);

@@ -56,7 +56,8 @@ struct AdapterFitOptions {
   // (ardsim_lidar NoiseOptions::saturation_range_bias_m, -0.02 m); added back along the ray. 0 switches the
   // correction off.
   double saturated_range_bias_m = -0.02;
-  double pixel_pitch_rad = 20.0 / 256.0 * 3.14159265358979 / 180.0;  // the sensor's angular pixel size
+  // The sensor's angular pixel size (the default sensor's; makeEstimator sets PoseConfig::sensor's).
+  double pixel_pitch_rad = 20.0 / 256.0 * 3.14159265358979 / 180.0;
   double plane_band_m = 0.05;    // a point belongs to a face when within this of it (prediction-based labels)
   double range_sigma_m = 0.012;  // expected range noise: robust weights and rejection scale with it
   double edge_step_min_m = 0.25;   // an inner ring edge: the neighbour lies this much behind the ring plane
