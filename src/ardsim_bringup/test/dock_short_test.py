@@ -2,12 +2,14 @@
 """Closed loop, the whole graph (dynamics + lidar + truth_pose stand-in + guidance, launch/docking.launch through
 scripts/run_scenario, record:=true): docking from 15 m ends in capture inside the envelope, and the run directory holds
 a closed bag with every topic, the report's figures, report.md and a complete summary.json; scripts/run_poses gives
-the truth of every frame from the bag."""
+the truth of every frame from the bag, and render_dataset, given those poses, their stamps and the run's lidar seed,
+the frames the run recorded."""
 import os
 import subprocess
 import sys
 import unittest
 
+import numpy as np
 import rosbag
 import rostest
 
@@ -22,6 +24,19 @@ SUMMARY_KEYS = ["docked", "collision", "aborted", "contact", "sim_time_s", "wall
                 "frames", "lost_frames", "methods", "delta_v_mps", "scenario", "seed"]
 CONTACT_KEYS = ["closing_speed_mps", "lateral_misalignment_m", "angular_misalignment_deg", "lateral_rate_mps",
                 "angular_rate_dps", "within_envelope"]
+
+
+def pcd_xyz(path):
+    """x y z (float32, N x 3) of render_dataset's binary PCD (fields x y z intensity, float32)."""
+    with open(path, "rb") as f:
+        while True:
+            line = f.readline().decode("ascii")
+            if line.startswith("FIELDS"):
+                assert line.split()[1:] == ["x", "y", "z", "intensity"], line
+            if line.startswith("DATA"):
+                assert line.split()[1] == "binary", line
+                break
+        return np.frombuffer(f.read(), dtype=np.float32).reshape(-1, 4)[:, :3]
 
 
 class DockShort(unittest.TestCase):
@@ -93,6 +108,37 @@ class DockShort(unittest.TestCase):
             self.assertGreater(abs(q.x * row[3] + q.y * row[4] + q.z * row[5] + q.w * row[6]), 1.0 - 1e-9, stamp)
             compared += 1
         self.assertGreaterEqual(compared, 0.99 * len(rows))
+
+        # render_dataset --stamps seeds each frame's noise as the lidar node did: the run's own frames, noise
+        # included (a few, the rest are the same code), so a closed loop's frames replay open loop exactly.
+        picks = [10, len(rows) // 2, len(rows) - 10]
+        with open(stamps_path) as f:
+            stamp_texts = [line.strip() for line in f]
+        render_in = os.path.join(out, "rerender")
+        os.makedirs(render_in)
+        with open(os.path.join(render_in, "poses.csv"), "w") as f:
+            f.writelines(" ".join(repr(x) for x in rows[k]) + "\n" for k in picks)
+        with open(os.path.join(render_in, "stamps.txt"), "w") as f:
+            f.writelines(stamp_texts[k] + "\n" for k in picks)
+        proc = subprocess.run([os.path.join(ROOT, "devel", "lib", "ardsim_lidar", "render_dataset"), "--target",
+                               "iss", "--poses", os.path.join(render_in, "poses.csv"), "--stamps",
+                               os.path.join(render_in, "stamps.txt"), "--seed", "2", "--width", "128", "--height",
+                               "128", "--out", os.path.join(render_in, "frames")],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        recorded_points = {}
+        with rosbag.Bag(os.path.join(out, "run.bag")) as bag:
+            for _, msg, _ in bag.read_messages(topics=["/lidar/points"]):
+                recorded_points[round(msg.header.stamp.to_sec(), 6)] = msg
+        for n, k in enumerate(picks):
+            msg = recorded_points[round(stamps[k], 6)]
+            recorded_xyz = np.frombuffer(msg.data, dtype=np.float32).reshape(-1, msg.point_step // 4)[:, :3]
+            rendered_xyz = pcd_xyz(os.path.join(render_in, "frames", "frame_%06d.pcd" % n))
+            self.assertEqual(rendered_xyz.shape, recorded_xyz.shape)
+            self.assertGreater(np.isfinite(recorded_xyz[:, 2]).sum(), 1000, stamps[k])
+            np.testing.assert_array_equal(np.isfinite(rendered_xyz), np.isfinite(recorded_xyz), str(stamps[k]))
+            finite = np.isfinite(recorded_xyz)
+            self.assertLess(np.abs(rendered_xyz[finite] - recorded_xyz[finite]).max(), 1e-6, stamps[k])
 
         for name in ["report.md", "summary.json", "run.json", "scenario.yaml", "fig4_relative_position.png",
                      "fig5_orientation_error.png", "fig6_velocity_thrust.png", "pose_error_vs_range.png",

@@ -21,10 +21,15 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: render_dataset --target iss|hubble --poses POSES.csv --out DIR [--noise on|off] [--seed N]\n"
-    "                      [--width W] [--height H] [--fov-deg F] [--arrays-deg A]\n"
+    "                      [--width W] [--height H] [--fov-deg F] [--arrays-deg A] [--stamps FILE]\n"
     "POSES.csv rows: x y z qx qy qz qw, the pose of `target` in `lidar_optical` (m, Hamilton quaternion).\n"
     "--arrays-deg: the solar arrays turned by A degrees (ISS: both solar alpha rotary joints; Hubble: both\n"
-    "arrays about their masts), to test estimators whose model has them at 0.";
+    "arrays about their masts), to test estimators whose model has them at 0.\n"
+    "--stamps FILE: one stamp (s, as scripts/run_poses --stamps takes them) per pose row; each frame's noise "
+    "is\n"
+    "then drawn as the lidar node draws that of a frame so stamped, so with the run's lidar seed as --seed "
+    "a\n"
+    "recorded run's frames come out as it saw them (else frame k is seeded with k).";
 
 struct Arguments {
   std::string target;
@@ -33,6 +38,7 @@ struct Arguments {
   bool noise = true;
   std::uint64_t seed = 1;
   double arrays_deg = 0.0;
+  std::string stamps;
   ardsim_lidar::SensorOptions sensor;
 };
 
@@ -80,6 +86,8 @@ Arguments parseArguments(int argc, char** argv) {
       a.sensor.height = static_cast<int>(parseInteger(flag, value));
     } else if (flag == "--fov-deg") {
       a.sensor.fov_deg = parseNumber(flag, value);
+    } else if (flag == "--stamps") {
+      a.stamps = value;
     } else if (flag == "--arrays-deg") {
       a.arrays_deg = parseNumber(flag, value);
       if (!(std::abs(a.arrays_deg) <= 360.0))
@@ -99,6 +107,36 @@ std::string frameName(std::size_t index, const char* extension) {
   return name;
 }
 
+// A stamp in seconds as the nanoseconds the lidar node seeds its frame with (ros::Time::toNSec), read from
+// the decimal text itself: through a double, 364.4 s would be 364399999999 ns.
+std::uint64_t stampNanoseconds(const std::string& path, int line_number, const std::string& text) {
+  const std::string where = path + ":" + std::to_string(line_number) + ": stamp '" + text + "' ";
+  const std::size_t dot = text.find('.');
+  const std::string whole = text.substr(0, dot);
+  std::string fraction = dot == std::string::npos ? "" : text.substr(dot + 1);
+  const auto digits = [](const std::string& t) {
+    return t.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (whole.empty() || whole.size() > 10 || !digits(whole) || !digits(fraction) || fraction.size() > 9)
+    throw std::invalid_argument(where + "is not a time of at most 9 decimals, >= 0 s");
+  fraction.resize(9, '0');
+  return std::stoull(whole) * 1000000000ull + std::stoull(fraction);
+}
+
+std::vector<std::uint64_t> readStamps(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw std::runtime_error("cannot read " + path);
+  std::vector<std::uint64_t> stamps_ns;
+  std::string line;
+  for (int line_number = 1; std::getline(file, line); ++line_number) {
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::size_t last = line.find_last_not_of(" \t\r");
+    stamps_ns.push_back(stampNanoseconds(path, line_number, line.substr(first, last - first + 1)));
+  }
+  return stamps_ns;
+}
+
 int run(int argc, char** argv) {
   const Arguments args = parseArguments(argc, argv);
   const ardsim_description::TargetKind kind = ardsim_description::parseTargetKind(args.target);
@@ -110,6 +148,16 @@ int run(int argc, char** argv) {
   for (const auto& error : errors)
     std::fprintf(stderr, "%s:%d: %s (row skipped)\n", args.poses.c_str(), error.line_number,
                  error.message.c_str());
+
+  std::vector<std::uint64_t> stamps_ns;
+  if (!args.stamps.empty()) {
+    stamps_ns = readStamps(args.stamps);
+    // A skipped row would pair every later pose with another frame's stamp.
+    if (!errors.empty() || stamps_ns.size() != poses.size())
+      throw std::invalid_argument("--stamps " + args.stamps + ": " + std::to_string(stamps_ns.size()) +
+                                  " stamps for " + std::to_string(poses.size()) + " poses and " +
+                                  std::to_string(errors.size()) + " bad rows: one stamp a pose row");
+  }
 
   ardsim_lidar::NoiseOptions noise;
   noise.enabled = args.noise;
@@ -131,28 +179,36 @@ int run(int argc, char** argv) {
   std::vector<Eigen::Isometry3d> T_lidar_target;
   for (const auto& row : poses) T_lidar_target.push_back(row.T_lidar_target);
   std::atomic<std::size_t> clipped{0};
-  simulator.simulateSequence(
-      T_lidar_target, 0, [&](std::size_t index, const ardsim_lidar::LidarFrame& frame) {
-        pcl::PointCloud<pcl::PointXYZI> cloud;
-        ardsim_lidar::toPointCloud(frame, simulator.rays(), &cloud);
-        const std::string pcd_path = (out / frameName(index, "pcd")).string();
-        if (pcl::io::savePCDFileBinary(pcd_path, cloud) != 0)
-          throw std::runtime_error("cannot write " + pcd_path);
-        cv::Mat range_mm(frame.height, frame.width, CV_16UC1);
-        for (int v = 0; v < frame.height; ++v) {
-          for (int u = 0; u < frame.width; ++u) {
-            const float range = frame.range_m[static_cast<std::size_t>(v) * frame.width + u];
-            double millimetres = std::isnan(range) ? 0.0 : std::round(1000.0 * range);  // 0 = no return
-            if (millimetres > 65535.0) {
-              millimetres = 65535.0;  // 16-bit millimetres end at 65.535 m
-              clipped.fetch_add(1, std::memory_order_relaxed);
-            }
-            range_mm.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(millimetres);
-          }
+  const auto write = [&](std::size_t index, const ardsim_lidar::LidarFrame& frame) {
+    pcl::PointCloud<pcl::PointXYZI> cloud;
+    ardsim_lidar::toPointCloud(frame, simulator.rays(), &cloud);
+    const std::string pcd_path = (out / frameName(index, "pcd")).string();
+    if (pcl::io::savePCDFileBinary(pcd_path, cloud) != 0)
+      throw std::runtime_error("cannot write " + pcd_path);
+    cv::Mat range_mm(frame.height, frame.width, CV_16UC1);
+    for (int v = 0; v < frame.height; ++v) {
+      for (int u = 0; u < frame.width; ++u) {
+        const float range = frame.range_m[static_cast<std::size_t>(v) * frame.width + u];
+        double millimetres = std::isnan(range) ? 0.0 : std::round(1000.0 * range);  // 0 = no return
+        if (millimetres > 65535.0) {
+          millimetres = 65535.0;  // 16-bit millimetres end at 65.535 m
+          clipped.fetch_add(1, std::memory_order_relaxed);
         }
-        const std::string png_path = (out / frameName(index, "png")).string();
-        if (!cv::imwrite(png_path, range_mm)) throw std::runtime_error("cannot write " + png_path);
-      });
+        range_mm.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(millimetres);
+      }
+    }
+    const std::string png_path = (out / frameName(index, "png")).string();
+    if (!cv::imwrite(png_path, range_mm)) throw std::runtime_error("cannot write " + png_path);
+  };
+  if (stamps_ns.empty()) {
+    simulator.simulateSequence(T_lidar_target, 0, write);
+  } else {  // frame by frame: the sequence's seeds are consecutive
+    ardsim_lidar::LidarFrame frame;
+    for (std::size_t index = 0; index < poses.size(); ++index) {
+      simulator.simulate(T_lidar_target[index], stamps_ns[index], &frame);
+      write(index, frame);
+    }
+  }
   for (std::size_t index = 0; index < poses.size(); ++index) {
     const Eigen::Isometry3d& T = poses[index].T_lidar_target;
     const Eigen::Quaterniond q(T.linear());
