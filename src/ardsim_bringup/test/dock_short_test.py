@@ -92,7 +92,8 @@ class DockShort(unittest.TestCase):
         self.assertEqual(proc.returncode, 0, proc.stderr)
         rows = [[float(x) for x in line.split()] for line in proc.stdout.splitlines() if not line.startswith("#")]
         with open(stamps_path) as f:
-            stamps = [float(line) for line in f]
+            stamp_texts = [line.strip() for line in f]
+        stamps = [float(text) for text in stamp_texts]
         self.assertEqual(len(rows), len(stamps))
         self.assertGreaterEqual(len(rows), 0.99 * s["frames"])
         with rosbag.Bag(os.path.join(out, "run.bag")) as bag:
@@ -112,8 +113,6 @@ class DockShort(unittest.TestCase):
         # render_dataset --stamps seeds each frame's noise as the lidar node did: the run's own frames, noise
         # included (a few, the rest are the same code), so a closed loop's frames replay open loop exactly.
         picks = [10, len(rows) // 2, len(rows) - 10]
-        with open(stamps_path) as f:
-            stamp_texts = [line.strip() for line in f]
         render_in = os.path.join(out, "rerender")
         os.makedirs(render_in)
         with open(os.path.join(render_in, "poses.csv"), "w") as f:
@@ -126,10 +125,13 @@ class DockShort(unittest.TestCase):
                                "128", "--out", os.path.join(render_in, "frames")],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.assertEqual(proc.returncode, 0, proc.stderr)
+        picked = {round(stamps[k], 6) for k in picks}
         recorded_points = {}
         with rosbag.Bag(os.path.join(out, "run.bag")) as bag:
             for _, msg, _ in bag.read_messages(topics=["/lidar/points"]):
-                recorded_points[round(msg.header.stamp.to_sec(), 6)] = msg
+                stamp = round(msg.header.stamp.to_sec(), 6)
+                if stamp in picked:
+                    recorded_points[stamp] = msg
         for n, k in enumerate(picks):
             msg = recorded_points[round(stamps[k], 6)]
             recorded_xyz = np.frombuffer(msg.data, dtype=np.float32).reshape(-1, msg.point_step // 4)[:, :3]

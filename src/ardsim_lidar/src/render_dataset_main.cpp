@@ -25,11 +25,9 @@ constexpr const char* kUsage =
     "POSES.csv rows: x y z qx qy qz qw, the pose of `target` in `lidar_optical` (m, Hamilton quaternion).\n"
     "--arrays-deg: the solar arrays turned by A degrees (ISS: both solar alpha rotary joints; Hubble: both\n"
     "arrays about their masts), to test estimators whose model has them at 0.\n"
-    "--stamps FILE: one stamp (s, as scripts/run_poses --stamps takes them) per pose row; each frame's noise "
-    "is\n"
-    "then drawn as the lidar node draws that of a frame so stamped, so with the run's lidar seed as --seed "
-    "a\n"
-    "recorded run's frames come out as it saw them (else frame k is seeded with k).";
+    "--stamps FILE: one stamp (s, as scripts/run_poses --stamps writes them) per pose row; each frame's\n"
+    "noise is then drawn as the lidar node draws that of a frame so stamped: with the run's lidar\n"
+    "seed as --seed, a recorded run's frames come out as it saw them (else frame k is seeded with k).";
 
 struct Arguments {
   std::string target;

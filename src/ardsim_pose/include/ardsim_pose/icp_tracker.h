@@ -24,11 +24,11 @@ namespace ardsim_pose {
 struct IcpOptions {
   // Scan points per frame (evenly spread over the gated valid pixels). The ISS since session 47: 4000
   // instead of 1000 halves its errors from 12 m out (its default closed loop, ICP alone, five lidar seeds:
-  // 12-30 m port 2.1-2.2 -> ~1.1 mm RMS, attitude 0.012 -> 0.007 deg; 30-100 m 2.0 -> ~1.0 mm, 0.010 ->
-  // 0.005 deg) and takes the single frames 4 sigma off at 12-16 m (a 1000-point draw; 10.5 mm where the RMS
-  // was 2.2) back within 3x the RMS, for 1.6-1.9x the instructions a frame at 100 and 30 m (the peers, given
-  // the same subsample, more). 5000 (the benchmark's 10 m frames primed from the truth by an acquisition
-  // that then never converged) is not.
+  // 12-30 m port 2.1-2.2 -> 1.2 mm RMS, attitude 0.012 -> 0.007 deg; 30-100 m 2.0 -> 1.0-1.1 mm, 0.010 ->
+  // 0.006 deg), and at 12-16 m the single frames 4 sigma off (a 1000-point draw; 10.5 mm where the RMS was
+  // 2.2) are gone (worst / RMS 2.79-4.31 -> 2.55-2.97), for 1.6-1.9x the instructions a frame at 100 and
+  // 30 m. 5000 (the benchmark's 10 m frames primed from the truth by an acquisition that then never
+  // converged) is not.
   int max_points = 4000;
   // Tracking (not acquiring), where the model's nearest predicted surface is nearer than near_depth_m (0:
   // never), max_points_near instead: there the ISS's docking adapter fills the view and its roll rests on a
