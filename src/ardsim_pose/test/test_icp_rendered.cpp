@@ -2,7 +2,8 @@
 // with and without noise, within a few frames, to the accuracy goals, never a wrong pose as TRACKING;
 // solar arrays turned away from the model, and filling the view at 250 m; LOST (not a wrong pose) on an empty
 // frame, a garbage frame and a frame of another object; the benchmark's 0.2 m-off guesses at 30 m corrected
-// along a weakly observed direction, with and without the sparse start.
+// along a weakly observed direction, with and without the sparse start; an acquisition whose iterations
+// cycle between two poses converging.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -154,6 +155,26 @@ TEST_F(RenderedIcp, ReusedVisibilityPredictionsKeepTheEstimates) {
     EXPECT_LT(error.port_position_error_m.norm(), 0.05);
     EXPECT_LT(error.attitude_error_angle_rad * 180.0 / M_PI, 0.1);
   }
+}
+
+// An acquisition at 9 m from the truth with 5000 scan points: nearest neighbours traded places between two
+// poses 1.2e-5 rad apart (just over converged_rotation_rad) for all 40 iterations, so the frame was DEGRADED
+// "not converged" and every next frame acquired again (~1 s each). A 2-cycle now ends at its midpoint.
+TEST_F(RenderedIcp, AcquisitionThatCyclesBetweenTwoPosesConverges) {
+  std::vector<OrganizedCloud> clouds;
+  std::vector<Eigen::Isometry3d> truths;
+  renderClosing(9.0, 1, &clouds, &truths);
+  PoseConfig config;
+  config.icp.max_points = 5000;
+  IcpTracker tracker(iss_model_, ardsim_lidar::intrinsicsFor(config.sensor), config.icp, config.visibility);
+  const PoseResult result = tracker.estimate(clouds[0], truths[0]);
+  EXPECT_EQ(result.status, EstimateStatus::kTracking) << result.reason;
+  EXPECT_LT(result.iterations, config.icp.max_iterations_acquisition);
+  EXPECT_FALSE(tracker.acquiring());
+  const PoseErrorValue error =
+      poseError(result.T_lidar_target, truths[0], ardsim_description::T_target_port(TargetKind::kIss));
+  EXPECT_LT(error.port_position_error_m.norm(), 0.005);
+  EXPECT_LT(error.attitude_error_angle_rad * 180.0 / M_PI, 0.02);
 }
 
 // At 249 m the arrays and radiators (not in the rigid model) fill most of the view: before the scan was gated
