@@ -1,15 +1,16 @@
 #!/usr/bin/python3
 """dataset_bands.py ESTIMATES.csv...
 
-Per evaluate_dataset run (its --out CSV), the 30-50 m and 20-30 m range bands: RMS / worst frame of the port
-position error and of the attitude error over the frames that are not LOST, and the worst frame over the RMS (the
-issue's "no breakdown" rule: within 3x); then a summary over all the runs. scripts/hubble_datasets calls it."""
+Per evaluate_dataset run (its --out CSV), each range band of evaluate_dataset's table that has frames, farthest
+first: RMS / worst frame of the port position error and of the attitude error over the frames that are not LOST,
+and the worst frame over the RMS (the issue's "no breakdown" rule: within 3x); then a summary over all the runs.
+scripts/approach_datasets calls it."""
 import csv
 import math
 import os
 import sys
 
-BANDS = ((30.0, 50.0), (20.0, 30.0))
+BANDS = ((75.0, math.inf), (50.0, 75.0), (30.0, 50.0), (20.0, 30.0), (10.0, 20.0), (0.0, 10.0))
 BREAKDOWN_RATIO = 3.0
 
 
@@ -17,6 +18,10 @@ def band_errors(rows, low_m, high_m):
     """(position errors m, attitude errors deg) of the frames in [low_m, high_m) that are not LOST."""
     frames = [r for r in rows if low_m <= float(r['range_m']) < high_m and r['status'] != 'LOST']
     return [float(r['pos_err_m']) for r in frames], [float(r['att_err_deg']) for r in frames]
+
+
+def band_label(low_m, high_m):
+    return f"{low_m:g}-{high_m:g}" if high_m < math.inf else f">={low_m:g}"
 
 
 def rms(values):
@@ -29,7 +34,7 @@ def main():
     summary = {band: {'pos_rms': [], 'att_rms': [], 'pos_worst': 0.0, 'att_worst': 0.0, 'pos_ok': 0,
                       'att_ok': 0} for band in BANDS}
     lost = 0
-    print(f"{'run':28s} {'band m':7s} {'pos RMS / worst cm':>19s} {'/RMS':>6s} {'att RMS / worst deg':>20s} "
+    print(f"{'run':28s} {'band m':7s} {'pos RMS / worst mm':>19s} {'/RMS':>6s} {'att RMS / worst deg':>20s} "
           f"{'/RMS':>6s}")
     for path in sys.argv[1:]:
         with open(path, newline='') as f:
@@ -48,15 +53,15 @@ def main():
             s['att_worst'] = max(s['att_worst'], max(att))
             s['pos_ok'] += max(pos) <= BREAKDOWN_RATIO * pos_rms
             s['att_ok'] += max(att) <= BREAKDOWN_RATIO * att_rms
-            print(f"{name:28s} {int(low_m):2d}-{int(high_m):2d}   {100 * pos_rms:8.2f} / {100 * max(pos):6.2f}"
+            print(f"{name:28s} {band_label(low_m, high_m):7s} {1e3 * pos_rms:8.2f} / {1e3 * max(pos):6.2f}"
                   f" {max(pos) / pos_rms:5.2f}x {att_rms:9.3f} / {max(att):6.3f} {max(att) / att_rms:5.2f}x")
     runs = len(sys.argv) - 1
     print(f"summary runs={runs} lost_frames={lost}")
     for (low_m, high_m), s in summary.items():
         if not s['pos_rms']:
             continue
-        print(f"  {int(low_m)}-{int(high_m)} m: position RMS {100 * min(s['pos_rms']):.2f}-"
-              f"{100 * max(s['pos_rms']):.2f} cm, worst frame {100 * s['pos_worst']:.2f} cm, within "
+        print(f"  {band_label(low_m, high_m)} m: position RMS {1e3 * min(s['pos_rms']):.2f}-"
+              f"{1e3 * max(s['pos_rms']):.2f} mm, worst frame {1e3 * s['pos_worst']:.2f} mm, within "
               f"{BREAKDOWN_RATIO:g}x the RMS in {s['pos_ok']} of {len(s['pos_rms'])}; attitude RMS "
               f"{min(s['att_rms']):.3f}-{max(s['att_rms']):.3f} deg, worst frame {s['att_worst']:.3f} deg, within "
               f"{BREAKDOWN_RATIO:g}x the RMS in {s['att_ok']} of {len(s['att_rms'])}")
