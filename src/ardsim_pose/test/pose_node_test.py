@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Interface test of the pose node/nodelet: drives the lidar with truth steps (the chaser on the ISS docking axis,
-its port 29 m out) and publishes bad clouds of its own; every cloud must be answered by exactly one pose/estimate
-with its stamp, and every estimate by one pose/error."""
+its port 29 m out) and publishes bad clouds of its own (NaN-filled, empty, unorganized, truncated, without a z
+field); every cloud must be answered by exactly one pose/estimate with its stamp, and every estimate by one
+pose/error."""
 import math
 import struct
 import subprocess
@@ -85,6 +86,16 @@ class PoseInterfaceTest(unittest.TestCase):
         self.assertEqual(estimate.header.frame_id, 'lidar_optical')
         return estimate
 
+    @staticmethod
+    def truncated(msg):
+        msg.data = msg.data[:1000]
+        return msg
+
+    @staticmethod
+    def renamed_z(msg):
+        msg.fields[2].name = 'w'
+        return msg
+
     def truth_step(self, stamp):
         position = tuple(t + o for t, o in zip(TARGET_ECI, CHASER_OFFSET))
         self.target.publish(odometry(stamp, 'target', TARGET_ECI, (0.0, 0.0, 0.0, 1.0)))
@@ -110,6 +121,12 @@ class PoseInterfaceTest(unittest.TestCase):
         unorganized = self.answer(6.0, lambda s: self.points.publish(cloud(s, 100, 1, 1.0)))
         self.assertEqual(unorganized.status, PoseEstimate.STATUS_LOST)
         self.assertIn('organized', unorganized.reason)
+        truncated = self.answer(6.5, lambda s: self.points.publish(self.truncated(cloud(s, 256, 256, 1.0))))
+        self.assertEqual(truncated.status, PoseEstimate.STATUS_LOST)
+        self.assertIn('shorter', truncated.reason)
+        no_z = self.answer(6.7, lambda s: self.points.publish(self.renamed_z(cloud(s, 256, 256, 1.0))))
+        self.assertEqual(no_z.status, PoseEstimate.STATUS_LOST)
+        self.assertIn('no field z', no_z.reason)
 
         # The node kept running and tracks again.
         estimate = self.answer(7.0, self.truth_step)
