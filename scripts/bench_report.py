@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Prints the medians of Google Benchmark JSON results, and the ratio peer / ours for every benchmark named
 BM_<Subject>_<Impl>/<args> whose Impl is not 'Ardsim' but shares Subject and args with an 'Ardsim' one."""
 import json
