@@ -39,12 +39,17 @@ bool poseOk(const geometry_msgs::Pose& pose, std::string* error) {
 
 }  // namespace
 
-bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, OrganizedCloud* cloud, std::string* error) {
+bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, const std::string& sensor_frame_id,
+                     OrganizedCloud* cloud, std::string* error) {
   cloud->width = static_cast<int>(msg.width);
   cloud->height = static_cast<int>(msg.height);
   cloud->stamp_s = msg.header.stamp.toSec();
   cloud->points.clear();
   cloud->intensity.clear();
+  if (msg.header.frame_id != sensor_frame_id) {
+    *error = "cloud in frame '" + msg.header.frame_id + "', not the sensor's '" + sensor_frame_id + "'";
+    return false;
+  }
   const std::size_t count = static_cast<std::size_t>(msg.width) * msg.height;
   if (count == 0) return true;
   if (msg.height < 2) {

@@ -17,9 +17,11 @@
 namespace ardsim_pose {
 
 // Organized cloud from lidar/points (float32 x, y, z; intensity optional). Returns false and says why in
-// *error for a cloud that is not organized, lacks a field, has another type or too little data. An empty
-// cloud (0 points) converts (to an empty frame).
-bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, OrganizedCloud* cloud, std::string* error);
+// *error for a cloud in a frame other than sensor_frame_id (its pixels would be read as the sensor's: a wrong
+// pose, not an error), one that is not organized, lacks a field, has another type or too little data. An
+// empty cloud (0 points) in the sensor's frame converts (to an empty frame).
+bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, const std::string& sensor_frame_id,
+                     OrganizedCloud* cloud, std::string* error);
 
 ardsim_msgs::PoseEstimatePtr toPoseEstimate(const EstimatorOutput& output, const std_msgs::Header& header);
 

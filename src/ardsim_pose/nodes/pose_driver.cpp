@@ -235,7 +235,7 @@ void PoseDriver::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   header.frame_id = options_.frame_id;
   std::string error;
   EstimatorOutput output;
-  if (!fromPointCloud2(*msg, &cloud_, &error)) {
+  if (!fromPointCloud2(*msg, options_.frame_id, &cloud_, &error)) {
     ARDSIM_WARN_THROTTLE(5.0, "pose: bad cloud at t = %.6f: %s; answering LOST", msg->header.stamp.toSec(),
                          error.c_str());
     // Keep the stamp and an empty frame: the estimator answers LOST and keeps its state.

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Interface test of the pose node/nodelet: drives the lidar with truth steps (the chaser on the ISS docking axis,
 its port 29 m out) and publishes bad clouds of its own (NaN-filled, empty, unorganized, truncated, without a z
-field); every cloud must be answered by exactly one pose/estimate with its stamp, and every estimate by one
-pose/error."""
+field, in another frame); every cloud must be answered by exactly one pose/estimate with its stamp, and every
+estimate by one pose/error."""
 import math
 import struct
 import subprocess
@@ -96,6 +96,11 @@ class PoseInterfaceTest(unittest.TestCase):
         msg.fields[2].name = 'w'
         return msg
 
+    @staticmethod
+    def in_chaser_frame(msg):
+        msg.header.frame_id = 'chaser'
+        return msg
+
     def truth_step(self, stamp):
         position = tuple(t + o for t, o in zip(TARGET_ECI, CHASER_OFFSET))
         self.target.publish(odometry(stamp, 'target', TARGET_ECI, (0.0, 0.0, 0.0, 1.0)))
@@ -127,6 +132,9 @@ class PoseInterfaceTest(unittest.TestCase):
         no_z = self.answer(6.7, lambda s: self.points.publish(self.renamed_z(cloud(s, 256, 256, 1.0))))
         self.assertEqual(no_z.status, PoseEstimate.STATUS_LOST)
         self.assertIn('no field z', no_z.reason)
+        other_frame = self.answer(6.8, lambda s: self.points.publish(self.in_chaser_frame(cloud(s, 256, 256, 1.0))))
+        self.assertEqual(other_frame.status, PoseEstimate.STATUS_LOST)
+        self.assertIn("frame 'chaser'", other_frame.reason)
 
         # The node kept running and tracks again.
         estimate = self.answer(7.0, self.truth_step)

@@ -10,8 +10,11 @@
 namespace ardsim_pose {
 namespace {
 
+const char kSensorFrame[] = "lidar_optical";
+
 sensor_msgs::PointCloud2 makeCloud(std::uint32_t width, std::uint32_t height, float value) {
   sensor_msgs::PointCloud2 msg;
+  msg.header.frame_id = kSensorFrame;
   msg.width = width;
   msg.height = height;
   const char* names[4] = {"x", "y", "z", "intensity"};
@@ -36,7 +39,7 @@ sensor_msgs::PointCloud2 makeCloud(std::uint32_t width, std::uint32_t height, fl
 TEST(PoseConversions, OrganizedCloudRoundTrip) {
   OrganizedCloud cloud;
   std::string error;
-  ASSERT_TRUE(fromPointCloud2(makeCloud(4, 3, 2.0f), &cloud, &error)) << error;
+  ASSERT_TRUE(fromPointCloud2(makeCloud(4, 3, 2.0f), kSensorFrame, &cloud, &error)) << error;
   EXPECT_EQ(cloud.width, 4);
   EXPECT_EQ(cloud.height, 3);
   ASSERT_EQ(cloud.points.size(), 12u);
@@ -48,17 +51,25 @@ TEST(PoseConversions, OrganizedCloudRoundTrip) {
 TEST(PoseConversions, RejectsMalformedClouds) {
   OrganizedCloud cloud;
   std::string error;
-  EXPECT_FALSE(fromPointCloud2(makeCloud(10, 1, 1.0f), &cloud, &error));
+  EXPECT_FALSE(fromPointCloud2(makeCloud(10, 1, 1.0f), kSensorFrame, &cloud, &error));
   EXPECT_NE(error.find("organized"), std::string::npos);
   sensor_msgs::PointCloud2 short_data = makeCloud(4, 3, 1.0f);
   short_data.data.resize(10);
-  EXPECT_FALSE(fromPointCloud2(short_data, &cloud, &error));
+  EXPECT_FALSE(fromPointCloud2(short_data, kSensorFrame, &cloud, &error));
   sensor_msgs::PointCloud2 no_z = makeCloud(4, 3, 1.0f);
   no_z.fields[2].name = "w";
-  EXPECT_FALSE(fromPointCloud2(no_z, &cloud, &error));
+  EXPECT_FALSE(fromPointCloud2(no_z, kSensorFrame, &cloud, &error));
   EXPECT_NE(error.find("z"), std::string::npos);
+  // A cloud in another frame (here the chaser body's, as a cloud transformed for display would be): refused,
+  // the estimator would read its points as the sensor's pixels.
+  sensor_msgs::PointCloud2 other_frame = makeCloud(4, 3, 1.0f);
+  other_frame.header.frame_id = "chaser";
+  EXPECT_FALSE(fromPointCloud2(other_frame, kSensorFrame, &cloud, &error));
+  EXPECT_NE(error.find("'chaser', not the sensor's 'lidar_optical'"), std::string::npos) << error;
+  other_frame.header.frame_id.clear();
+  EXPECT_FALSE(fromPointCloud2(other_frame, kSensorFrame, &cloud, &error));
   // An empty cloud converts to an empty frame (the estimator answers LOST).
-  EXPECT_TRUE(fromPointCloud2(makeCloud(0, 0, 1.0f), &cloud, &error));
+  EXPECT_TRUE(fromPointCloud2(makeCloud(0, 0, 1.0f), kSensorFrame, &cloud, &error));
   EXPECT_TRUE(cloud.points.empty());
 }
 
