@@ -133,6 +133,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "estimator/velocity_smoothing", &c.estimator.velocity_smoothing);
   read(nh, "estimator/angular_velocity_smoothing", &c.estimator.angular_velocity_smoothing);
   read(nh, "estimator/max_prediction_gap_s", &c.estimator.max_prediction_gap_s);
+  read(nh, "estimator/restart_time_jump_s", &c.estimator.restart_time_jump_s);
   read(nh, "estimator/composite_min_port_range_m", &c.estimator.composite_min_port_range_m);
   read(nh, "estimator/composite_max_port_range_m", &c.estimator.composite_max_port_range_m);
   read(nh, "estimator/composite_icp_roll_max_sigma_deg", &c.estimator.composite_icp_roll_max_sigma_deg);
@@ -246,6 +247,11 @@ void PoseDriver::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   } else {
     output = estimator_->process(cloud_);
   }
+  if (output.restarted_back_s > 0.0)
+    ARDSIM_WARN_THROTTLE(5.0,
+                         "pose: t = %.6f is %.3f s before the frame before: time went back, started again "
+                         "from the initial estimate",
+                         msg->header.stamp.toSec(), output.restarted_back_s);
   if (output.result.status == EstimateStatus::kLost)
     ARDSIM_WARN_THROTTLE(5.0, "pose: LOST at t = %.6f: %s", msg->header.stamp.toSec(),
                          output.result.reason.c_str());

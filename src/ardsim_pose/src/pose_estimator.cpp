@@ -45,6 +45,8 @@ void validate(const EstimatorOptions& o) {
                 "estimator/angular_velocity_smoothing", o.angular_velocity_smoothing, "> 0 .. 1");
   requireOption(std::isfinite(o.max_prediction_gap_s) && o.max_prediction_gap_s >= 0.0,
                 "estimator/max_prediction_gap_s", o.max_prediction_gap_s, ">= 0");
+  requireOption(std::isfinite(o.restart_time_jump_s) && o.restart_time_jump_s >= 0.0,
+                "estimator/restart_time_jump_s", o.restart_time_jump_s, ">= 0");
   const bool composite_off = o.composite_min_port_range_m == 0.0 && o.composite_max_port_range_m == 0.0;
   requireOption(
       composite_off || (o.composite_min_port_range_m >= 0.0 && o.composite_min_port_range_m <= 1000.0),
@@ -125,6 +127,7 @@ void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
   velocity_mps_.setZero();
   angular_velocity_radps_.setZero();
   have_previous_ = false;
+  have_frame_ = false;
   recent_.clear();
   for (auto& method : methods_) method.second->reset();
   selector_->reset();
@@ -257,6 +260,12 @@ Eigen::Isometry3d PoseEstimator::medianOf(const std::deque<std::pair<double, Eig
 EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
   const auto start = std::chrono::steady_clock::now();
   EstimatorOutput out;
+  if (have_frame_ && cloud.stamp_s < frame_stamp_s_ - options_.restart_time_jump_s) {
+    out.restarted_back_s = frame_stamp_s_ - cloud.stamp_s;
+    setPrior(prior_);
+  }
+  have_frame_ = true;
+  frame_stamp_s_ = cloud.stamp_s;
   SelectionInput input;
   input.cloud = &cloud;
   input.T_lidar_target_predicted = predict(cloud.stamp_s);

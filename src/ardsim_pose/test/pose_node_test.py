@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Interface test of the pose node/nodelet: drives the lidar with truth steps (the chaser on the ISS docking axis,
 its port 29 m out) and publishes bad clouds of its own (NaN-filled, empty, unorganized, truncated, without a z
-field, in another frame); every cloud must be answered by exactly one pose/estimate with its stamp, and every
-estimate by one pose/error."""
+field, in another frame), then steps time back; every cloud must be answered by exactly one pose/estimate with
+its stamp, and every estimate by one pose/error."""
 import math
 import struct
 import subprocess
@@ -14,7 +14,7 @@ import rospy
 import rostest
 from ardsim_msgs.msg import PoseError, PoseEstimate
 from nav_msgs.msg import Odometry
-from rosgraph_msgs.msg import Clock
+from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import PointCloud2, PointField
 
 TARGET_ECI = (6.778e6, 1.25e5, -2.5e5)
@@ -53,8 +53,10 @@ class PoseInterfaceTest(unittest.TestCase):
         self.lock = threading.Lock()
         self.estimates = []
         self.errors = []
+        self.logs = []
         self.subscribers = [rospy.Subscriber('pose/estimate', PoseEstimate, self.store, self.estimates, queue_size=50),
-                            rospy.Subscriber('pose/error', PoseError, self.store, self.errors, queue_size=50)]
+                            rospy.Subscriber('pose/error', PoseError, self.store, self.errors, queue_size=50),
+                            rospy.Subscriber('/rosout', Log, self.store, self.logs, queue_size=200)]
         self.clock = rospy.Publisher('/clock', Clock, queue_size=10, latch=True)
         self.target = rospy.Publisher('truth/target/odom', Odometry, queue_size=10)
         self.chaser = rospy.Publisher('truth/chaser/odom', Odometry, queue_size=10)
@@ -139,6 +141,11 @@ class PoseInterfaceTest(unittest.TestCase):
         # The node kept running and tracks again.
         estimate = self.answer(7.0, self.truth_step)
         self.assertNotEqual(estimate.status, PoseEstimate.STATUS_LOST, estimate.reason)
+
+        # Time back 6 s (a bag played again): logged, the estimator starts again from the initial estimate.
+        estimate = self.answer(1.0, self.truth_step)
+        self.assertNotEqual(estimate.status, PoseEstimate.STATUS_LOST, estimate.reason)
+        self.wait_for(lambda: any('time went back' in m.msg for m in self.logs), 'the time jump logged')
 
     def test_bad_parameter_stops_the_node_with_a_clear_error(self):
         # One node name per case: a _param:= setting stays on the parameter server after its node exits.

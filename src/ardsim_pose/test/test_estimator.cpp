@@ -1,6 +1,6 @@
 // The estimator facade (PoseEstimator) with scripted methods: the median filter on a steady approach, and
-// what the motion prediction learns from TRACKING, DEGRADED and acquisition estimates; the per-target config;
-// which points of a frame are returns (isReturn).
+// what the motion prediction learns from TRACKING, DEGRADED and acquisition estimates, and forgets when time
+// goes back; the per-target config; which points of a frame are returns (isReturn).
 #include <cmath>
 #include <limits>
 #include <map>
@@ -287,6 +287,51 @@ TEST(PoseEstimatorPrediction, AnUnobservedOrHeldBoresightRotationIsNoMotion) {
 // The rotation rate starts at zero and learns from each TRACKING pair by angular_velocity_smoothing: a
 // single frame's attitude error moves the next prediction by that fraction of it again (Hubble, 0.2), not
 // by all of it (whole: the next prediction twice as far off, the other frames' estimates the same).
+// Each frame's stamp in order, the prediction it was given and how far back the estimator restarted.
+struct ReplayedFrame {
+  int frame;
+  Eigen::Isometry3d predicted;
+  double restarted_back_s;
+};
+std::vector<ReplayedFrame> predictionsOverStamps(const std::vector<int>& frames) {
+  auto script = std::make_unique<MotionScript>(std::map<int, MotionScript::Step>{});
+  MotionScript* probe = script.get();
+  PoseEstimator::Methods methods;
+  methods[EstimateMethod::kIcp] = std::move(script);
+  PoseEstimator estimator(wholeRate(), std::move(methods),
+                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
+  estimator.setPrior(MotionScript::truth(0));
+  std::vector<ReplayedFrame> replayed;
+  OrganizedCloud cloud;
+  for (int frame : frames) {
+    cloud.stamp_s = kFramePeriodS * frame;
+    const EstimatorOutput out = estimator.process(cloud);
+    replayed.push_back({frame, probe->predictions.at(frame), out.restarted_back_s});
+  }
+  return replayed;
+}
+
+// A bag played again: frames 0-29 (2.9 s, 14.5 m of closing), then 0-2 again. The first frame back is
+// predicted at the prior, not at the last good estimate 14.5 m away, and the velocity is learnt again. A
+// frame 0.2 s out of order (restart_time_jump_s 1 s) resets nothing: predicted at the last good estimate.
+TEST(PoseEstimatorPrediction, TimeGoingBackStartsAgainFromThePriorAFrameOutOfOrderDoesNot) {
+  std::vector<int> frames;
+  for (int frame = 0; frame < 30; ++frame) frames.push_back(frame);
+  frames.insert(frames.end(), {0, 1, 2});
+  const std::vector<ReplayedFrame> loop = predictionsOverStamps(frames);
+  EXPECT_DOUBLE_EQ(loop[29].restarted_back_s, 0.0);
+  EXPECT_LT((loop[29].predicted.translation() - MotionScript::truth(29).translation()).norm(), 1e-9);
+  EXPECT_NEAR(loop[30].restarted_back_s, 2.9, 1e-9);
+  EXPECT_LT((loop[30].predicted.translation() - MotionScript::truth(0).translation()).norm(), 1e-9);
+  EXPECT_LT(angleDeg(loop[30].predicted, MotionScript::truth(0)), 1e-6);
+  EXPECT_DOUBLE_EQ(loop[31].restarted_back_s, 0.0);
+  EXPECT_LT((loop[32].predicted.translation() - MotionScript::truth(2).translation()).norm(), 1e-9);
+
+  const std::vector<ReplayedFrame> out_of_order = predictionsOverStamps({0, 1, 2, 3, 4, 5, 3, 6});
+  EXPECT_DOUBLE_EQ(out_of_order[6].restarted_back_s, 0.0);
+  EXPECT_LT((out_of_order[6].predicted.translation() - MotionScript::truth(5).translation()).norm(), 1e-9);
+}
+
 TEST(PoseEstimatorPrediction, TheRotationRateLearnsFromSeveralFrames) {
   using Step = MotionScript::Step;
   EstimatorOptions hubble;
@@ -565,6 +610,9 @@ TEST(PoseEstimatorOptions, OutOfRangeFilterOptionsAreRefusedByName) {
   options = EstimatorOptions();
   options.max_prediction_gap_s = -1.0;
   expectRefused(options, "estimator/max_prediction_gap_s = -1");
+  options = EstimatorOptions();
+  options.restart_time_jump_s = -0.5;
+  expectRefused(options, "estimator/restart_time_jump_s = -0.5");
 }
 
 TEST(PoseEstimatorComposite, BadBandOrMissingMethodIsRefused) {

@@ -58,6 +58,11 @@ struct EstimatorOptions {
   // 6 mm off; approach datasets, 30-50 m position within 3x the RMS in 19 -> 24 of 24 runs).
   double angular_velocity_smoothing = 0.5;
   double max_prediction_gap_s = 2.0;  // a longer gap since the last good estimate: predict without velocity
+  // A frame stamped more than this before the frame before it: time went back (a bag played again, a
+  // simulation restarted), and the history belongs to another run. The estimator starts again from its
+  // prior (after LOST it would search only near the last good estimate, which can be 80 m off by then).
+  // Less far back, a frame out of order: predicted without velocity, nothing reset.
+  double restart_time_jump_s = 1.0;
   // Composite pose, in the band of predicted lidar-to-port ranges [min, max) (both 0: off; makeEstimator
   // turns it off unless the method is auto): ICP and the docking-ring method both run on the frame, and the
   // pose takes the port position from the ring, the tilt across the line of sight from ICP, the rotation
@@ -80,6 +85,9 @@ struct EstimatorOutput {
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();            // target origin, in lidar_optical
   Eigen::Vector3d angular_velocity_radps = Eigen::Vector3d::Zero();  // in lidar_optical
   bool velocity_valid = false;
+  // This frame went back in time by more than EstimatorOptions::restart_time_jump_s (s before the frame
+  // before; 0 otherwise): the estimator started again from its prior.
+  double restarted_back_s = 0.0;
   double compute_ms = 0.0;  // wall clock of this frame, diagnostic only
 };
 
@@ -125,6 +133,8 @@ class PoseEstimator {
   bool velocity_valid_ = false;
   PoseResult previous_;
   bool have_previous_ = false;
+  bool have_frame_ = false;                                  // a frame since the prior
+  double frame_stamp_s_ = 0.0;                               // its stamp
   std::deque<std::pair<double, Eigen::Isometry3d>> recent_;  // (stamp s, good raw estimate), for the filter
 };
 
