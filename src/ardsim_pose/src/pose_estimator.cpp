@@ -127,7 +127,6 @@ void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
   velocity_mps_.setZero();
   angular_velocity_radps_.setZero();
   have_previous_ = false;
-  have_frame_ = false;
   recent_.clear();
   for (auto& method : methods_) method.second->reset();
   selector_->reset();
@@ -260,12 +259,10 @@ Eigen::Isometry3d PoseEstimator::medianOf(const std::deque<std::pair<double, Eig
 EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
   const auto start = std::chrono::steady_clock::now();
   EstimatorOutput out;
-  if (have_frame_ && cloud.stamp_s < frame_stamp_s_ - options_.restart_time_jump_s) {
-    out.restarted_back_s = frame_stamp_s_ - cloud.stamp_s;
+  if (have_previous_ && cloud.stamp_s < previous_stamp_s_ - options_.restart_time_jump_s) {
+    out.restarted_back_s = previous_stamp_s_ - cloud.stamp_s;
     setPrior(prior_);
   }
-  have_frame_ = true;
-  frame_stamp_s_ = cloud.stamp_s;
   SelectionInput input;
   input.cloud = &cloud;
   input.T_lidar_target_predicted = predict(cloud.stamp_s);
@@ -318,6 +315,7 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
     }
   }
   previous_ = out.result;
+  previous_stamp_s_ = cloud.stamp_s;
   have_previous_ = true;
   if (out.result.status != EstimateStatus::kLost) {
     updateVelocity(out.result, cloud.stamp_s);

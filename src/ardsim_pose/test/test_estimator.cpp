@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -173,9 +174,15 @@ EstimatorOptions wholeRate() {
   return options;
 }
 
-// The prediction each of frames 0 .. frames-1 was given by an estimator over MotionScript(steps).
-std::map<int, Eigen::Isometry3d> predictionsOver(std::map<int, MotionScript::Step> steps, int frames,
-                                                 const EstimatorOptions& options = wholeRate()) {
+// For each frame in the order given (frame k at stamp 0.1 k), by an estimator over MotionScript(steps): the
+// prediction it was given and how far back the estimator restarted.
+struct ReplayedFrame {
+  Eigen::Isometry3d predicted;
+  double restarted_back_s;
+};
+std::vector<ReplayedFrame> replayFrames(const std::vector<int>& frames,
+                                        std::map<int, MotionScript::Step> steps = {},
+                                        const EstimatorOptions& options = wholeRate()) {
   auto script = std::make_unique<MotionScript>(std::move(steps));
   MotionScript* probe = script.get();
   PoseEstimator::Methods methods;
@@ -183,12 +190,25 @@ std::map<int, Eigen::Isometry3d> predictionsOver(std::map<int, MotionScript::Ste
   PoseEstimator estimator(options, std::move(methods),
                           std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
   estimator.setPrior(MotionScript::truth(0));
+  std::vector<ReplayedFrame> replayed;
   OrganizedCloud cloud;
-  for (int frame = 0; frame < frames; ++frame) {
+  for (int frame : frames) {
     cloud.stamp_s = kFramePeriodS * frame;
-    estimator.process(cloud);
+    const EstimatorOutput out = estimator.process(cloud);
+    replayed.push_back({probe->predictions.at(frame), out.restarted_back_s});
   }
-  return probe->predictions;
+  return replayed;
+}
+
+// The prediction each of frames 0 .. frames-1 was given by an estimator over MotionScript(steps).
+std::map<int, Eigen::Isometry3d> predictionsOver(std::map<int, MotionScript::Step> steps, int frames,
+                                                 const EstimatorOptions& options = wholeRate()) {
+  std::vector<int> in_order(static_cast<std::size_t>(frames));
+  std::iota(in_order.begin(), in_order.end(), 0);
+  const std::vector<ReplayedFrame> replayed = replayFrames(in_order, std::move(steps), options);
+  std::map<int, Eigen::Isometry3d> predictions;
+  for (int frame = 0; frame < frames; ++frame) predictions[frame] = replayed[frame].predicted;
+  return predictions;
 }
 
 double angleDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -284,33 +304,6 @@ TEST(PoseEstimatorPrediction, AnUnobservedOrHeldBoresightRotationIsNoMotion) {
   EXPECT_NEAR(std::abs(turn.angle() * turn.axis().z() * 180.0 / M_PI), 1.0, 0.02);
 }
 
-// The rotation rate starts at zero and learns from each TRACKING pair by angular_velocity_smoothing: a
-// single frame's attitude error moves the next prediction by that fraction of it again (Hubble, 0.2), not
-// by all of it (whole: the next prediction twice as far off, the other frames' estimates the same).
-// Each frame's stamp in order, the prediction it was given and how far back the estimator restarted.
-struct ReplayedFrame {
-  int frame;
-  Eigen::Isometry3d predicted;
-  double restarted_back_s;
-};
-std::vector<ReplayedFrame> predictionsOverStamps(const std::vector<int>& frames) {
-  auto script = std::make_unique<MotionScript>(std::map<int, MotionScript::Step>{});
-  MotionScript* probe = script.get();
-  PoseEstimator::Methods methods;
-  methods[EstimateMethod::kIcp] = std::move(script);
-  PoseEstimator estimator(wholeRate(), std::move(methods),
-                          std::make_unique<FixedMethodSelector>(EstimateMethod::kIcp));
-  estimator.setPrior(MotionScript::truth(0));
-  std::vector<ReplayedFrame> replayed;
-  OrganizedCloud cloud;
-  for (int frame : frames) {
-    cloud.stamp_s = kFramePeriodS * frame;
-    const EstimatorOutput out = estimator.process(cloud);
-    replayed.push_back({frame, probe->predictions.at(frame), out.restarted_back_s});
-  }
-  return replayed;
-}
-
 // A bag played again: frames 0-29 (2.9 s, 14.5 m of closing), then 0-2 again. The first frame back is
 // predicted at the prior, not at the last good estimate 14.5 m away, and the velocity is learnt again. A
 // frame 0.2 s out of order (restart_time_jump_s 1 s) resets nothing: predicted at the last good estimate.
@@ -318,7 +311,7 @@ TEST(PoseEstimatorPrediction, TimeGoingBackStartsAgainFromThePriorAFrameOutOfOrd
   std::vector<int> frames;
   for (int frame = 0; frame < 30; ++frame) frames.push_back(frame);
   frames.insert(frames.end(), {0, 1, 2});
-  const std::vector<ReplayedFrame> loop = predictionsOverStamps(frames);
+  const std::vector<ReplayedFrame> loop = replayFrames(frames);
   EXPECT_DOUBLE_EQ(loop[29].restarted_back_s, 0.0);
   EXPECT_LT((loop[29].predicted.translation() - MotionScript::truth(29).translation()).norm(), 1e-9);
   EXPECT_NEAR(loop[30].restarted_back_s, 2.9, 1e-9);
@@ -327,11 +320,14 @@ TEST(PoseEstimatorPrediction, TimeGoingBackStartsAgainFromThePriorAFrameOutOfOrd
   EXPECT_DOUBLE_EQ(loop[31].restarted_back_s, 0.0);
   EXPECT_LT((loop[32].predicted.translation() - MotionScript::truth(2).translation()).norm(), 1e-9);
 
-  const std::vector<ReplayedFrame> out_of_order = predictionsOverStamps({0, 1, 2, 3, 4, 5, 3, 6});
+  const std::vector<ReplayedFrame> out_of_order = replayFrames({0, 1, 2, 3, 4, 5, 3, 6});
   EXPECT_DOUBLE_EQ(out_of_order[6].restarted_back_s, 0.0);
   EXPECT_LT((out_of_order[6].predicted.translation() - MotionScript::truth(5).translation()).norm(), 1e-9);
 }
 
+// The rotation rate starts at zero and learns from each TRACKING pair by angular_velocity_smoothing: a
+// single frame's attitude error moves the next prediction by that fraction of it again (Hubble, 0.2), not
+// by all of it (whole: the next prediction twice as far off, the other frames' estimates the same).
 TEST(PoseEstimatorPrediction, TheRotationRateLearnsFromSeveralFrames) {
   using Step = MotionScript::Step;
   EstimatorOptions hubble;

@@ -132,9 +132,8 @@ class PoseEstimator {
   Eigen::Vector3d angular_velocity_radps_ = Eigen::Vector3d::Zero();
   bool velocity_valid_ = false;
   PoseResult previous_;
-  bool have_previous_ = false;
-  bool have_frame_ = false;                                  // a frame since the prior
-  double frame_stamp_s_ = 0.0;                               // its stamp
+  double previous_stamp_s_ = 0.0;
+  bool have_previous_ = false;                               // a frame since the prior
   std::deque<std::pair<double, Eigen::Isometry3d>> recent_;  // (stamp s, good raw estimate), for the filter
 };
 
