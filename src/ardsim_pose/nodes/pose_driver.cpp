@@ -1,6 +1,7 @@
 #include "pose_driver.h"
 
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <vector>
 
@@ -53,6 +54,10 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "frame_id", &o.frame_id);
   read(nh, "child_frame_id", &o.child_frame_id);
   read(nh, "publish_tf", &o.publish_tf);
+  read(nh, "cloud_queue_size", &o.cloud_queue_size);
+  if (o.cloud_queue_size < 1 || o.cloud_queue_size > 1000)
+    throw std::invalid_argument("parameter cloud_queue_size = " + std::to_string(o.cloud_queue_size) +
+                                " is out of range: 1 .. 1000");
 
   read(nh, "model/spacing_at_port_m", &c.model.spacing_at_port_m);
   read(nh, "model/spacing_growth_per_m", &c.model.spacing_growth_per_m);
@@ -218,7 +223,8 @@ PoseDriver::PoseDriver(ros::NodeHandle nh, const ros::NodeHandle& private_nh)
   // Latched: a subscriber that connects late still gets the current step's estimate. A deep queue per
   // subscriber: a recorder stalled by its disk must not lose estimates (with 2 it lost runs of ~80).
   estimate_publisher_ = nh.advertise<ardsim_msgs::PoseEstimate>("pose/estimate", 1000, true);
-  cloud_subscriber_ = nh.subscribe("lidar/points", 2, &PoseDriver::onCloud, this);
+  cloud_subscriber_ = nh.subscribe("lidar/points", static_cast<std::uint32_t>(options_.cloud_queue_size),
+                                   &PoseDriver::onCloud, this);
   ROS_INFO("pose: %s, method %s, %dx%d %.1f deg, initial %s (%.2f %.2f %.2f m)%s",
            ardsim_description::targetKindName(options_.config.target).c_str(), options_.config.method.c_str(),
            options_.config.sensor.width, options_.config.sensor.height, options_.config.sensor.fov_deg,
@@ -246,6 +252,14 @@ void PoseDriver::onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     output.result.reason = "bad cloud: " + error;
   } else {
     output = estimator_->process(cloud_);
+  }
+  if (output.frames_missing > 0) {
+    frames_missing_total_ += output.frames_missing;
+    ARDSIM_WARN_THROTTLE(5.0,
+                         "pose: %d frame(s) missing before t = %.6f (%ld since the start): dropped from the "
+                         "lidar/points queue (cloud_queue_size %d) or never published",
+                         output.frames_missing, msg->header.stamp.toSec(), frames_missing_total_,
+                         options_.cloud_queue_size);
   }
   if (output.restarted_back_s > 0.0)
     ARDSIM_WARN_THROTTLE(5.0,

@@ -21,6 +21,10 @@ struct PoseNodeOptions {
   std::string frame_id = "lidar_optical";
   std::string child_frame_id = "target_estimated";
   bool publish_tf = true;
+  // lidar/points frames held while one is estimated; beyond it the oldest is dropped (and the next estimate's
+  // frames_missing logged). 10 (~10 MB of 256 x 256 clouds) covers an acquisition search's few hundred ms
+  // at a bag player's 2x pace; the lockstep loop never queues more than one.
+  int cloud_queue_size = 10;
   // Where the first frame starts: "docking_axis" (the chaser on the docking axis, its port
   // initial/port_distance_m out), "parameters" (initial/position_m and initial/rpy_deg: T_lidar_target) or
   // "scenario" (the chaser's initial state in initial/scenario_file).
@@ -58,6 +62,7 @@ class PoseDriver {
   // is answered again with it, not estimated twice, so the estimator's history does not depend on connection
   // timing.
   ardsim_msgs::PoseEstimateConstPtr last_estimate_;
+  long frames_missing_total_ = 0;
 };
 
 }  // namespace ardsim_pose

@@ -127,6 +127,7 @@ void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
   velocity_mps_.setZero();
   angular_velocity_radps_.setZero();
   have_previous_ = false;
+  frame_interval_s_ = 0.0;
   recent_.clear();
   for (auto& method : methods_) method.second->reset();
   selector_->reset();
@@ -263,6 +264,13 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
     out.restarted_back_s = previous_stamp_s_ - cloud.stamp_s;
     setPrior(prior_);
   }
+  if (have_previous_ && cloud.stamp_s > newest_stamp_s_) {
+    const double interval_s = cloud.stamp_s - newest_stamp_s_;
+    // Half a period of slack: a frame's stamp is the simulation's step time, exact to the step.
+    if (frame_interval_s_ > 0.0 && interval_s > 1.5 * frame_interval_s_)
+      out.frames_missing = static_cast<int>(std::lround(interval_s / frame_interval_s_)) - 1;
+    frame_interval_s_ = frame_interval_s_ > 0.0 ? std::min(frame_interval_s_, interval_s) : interval_s;
+  }
   SelectionInput input;
   input.cloud = &cloud;
   input.T_lidar_target_predicted = predict(cloud.stamp_s);
@@ -316,6 +324,7 @@ EstimatorOutput PoseEstimator::process(const OrganizedCloud& cloud) {
   }
   previous_ = out.result;
   previous_stamp_s_ = cloud.stamp_s;
+  newest_stamp_s_ = have_previous_ ? std::max(newest_stamp_s_, cloud.stamp_s) : cloud.stamp_s;
   have_previous_ = true;
   if (out.result.status != EstimateStatus::kLost) {
     updateVelocity(out.result, cloud.stamp_s);
