@@ -127,7 +127,6 @@ void PoseEstimator::setPrior(const Eigen::Isometry3d& T_lidar_target) {
   velocity_mps_.setZero();
   angular_velocity_radps_.setZero();
   have_previous_ = false;
-  frame_interval_s_ = 0.0;
   recent_.clear();
   for (auto& method : methods_) method.second->reset();
   selector_->reset();

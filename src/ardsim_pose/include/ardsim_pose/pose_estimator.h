@@ -89,8 +89,9 @@ struct EstimatorOutput {
   // before; 0 otherwise): the estimator started again from its prior.
   double restarted_back_s = 0.0;
   // Frames that should have come between this one and the newest before it, going by the shortest interval
-  // between frames since the prior (the sensor's period): dropped on the way (a subscriber's queue that a
-  // player outran) or never sent. 0 for the first frame, a frame out of order and one after a restart.
+  // between frames seen (the sensor's period, kept through a restart: the stream's, not the history's):
+  // dropped on the way (a subscriber's queue that a player outran, most often while an acquisition search
+  // takes its few hundred ms) or never sent. 0 for the first frame, one out of order and one after a restart.
   int frames_missing = 0;
   double compute_ms = 0.0;  // wall clock of this frame, diagnostic only
 };
@@ -138,8 +139,8 @@ class PoseEstimator {
   PoseResult previous_;
   double previous_stamp_s_ = 0.0;
   bool have_previous_ = false;  // a frame since the prior
-  // The newest stamp and the shortest interval between frames since the prior (0: none yet), for
-  // frames_missing: a frame out of order leaves a gap after it that is none.
+  // For frames_missing: the newest stamp since the prior (a frame out of order leaves a gap after it that is
+  // none) and the shortest interval between frames seen (0: none yet).
   double newest_stamp_s_ = 0.0;
   double frame_interval_s_ = 0.0;
   std::deque<std::pair<double, Eigen::Isometry3d>> recent_;  // (stamp s, good raw estimate), for the filter
