@@ -327,8 +327,9 @@ TEST(PoseEstimatorPrediction, TimeGoingBackStartsAgainFromThePriorAFrameOutOfOrd
 }
 
 // Frames dropped on the way (a bag player outrunning the node's queue) are counted by the sensor's period,
-// the shortest interval seen: here frame 4 and frames 7-9. Out of order, after a restart and at the first
-// frame none is counted; the first interval after a restart is learnt afresh.
+// the shortest interval seen: here frame 4, frames 7-9, and after the bag starts again frames 1 and 4 (the
+// interval is the stream's, kept through the restart: frames dropped while the estimator acquires again count
+// too). Out of order, at the restart and at the first frame none is counted.
 TEST(PoseEstimatorPrediction, FramesMissingAreCountedByTheShortestInterval) {
   const std::vector<ReplayedFrame> gaps = replayFrames({0, 1, 2, 3, 5, 6, 10, 11, 9, 12, 0, 2, 3, 5});
   const std::vector<int> expected = {0, 0, 0, 0, 1, 0, 3, 0, 0, 0, 0, 1, 0, 1};
