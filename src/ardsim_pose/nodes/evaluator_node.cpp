@@ -1,6 +1,10 @@
 // pose_evaluator: publishes pose/error (estimate minus truth at the same stamp) for every pose/estimate.
 // Truth T_lidar_target comes from truth/target/odom and truth/chaser/odom (paired by exact stamp) with
 // T_chaser_lidar. Either side may arrive first: both wait in bounded buffers keyed by stamp. Evaluation only.
+// Time going back (a bag played again, a simulation restarted) empties the buffers: what waits there is of
+// the old time line, and being newer it would outlive the new messages when a buffer is bounded (the oldest
+// go first).
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -27,6 +31,10 @@ class PoseEvaluator {
     if (buffer_size_ < 1 || buffer_size_ > 10000)
       throw std::invalid_argument("parameter buffer_size = " + std::to_string(buffer_size_) +
                                   " is out of range: 1 .. 10000");
+    private_nh.param("restart_time_jump_s", restart_time_jump_s_, restart_time_jump_s_);
+    if (!(std::isfinite(restart_time_jump_s_) && restart_time_jump_s_ >= 0.0))
+      throw std::invalid_argument("parameter restart_time_jump_s = " + std::to_string(restart_time_jump_s_) +
+                                  " is out of range: >= 0");
     T_chaser_lidar_ = ardsim_description::T_chaser_lidar();
     error_publisher_ = nh.advertise<ardsim_msgs::PoseError>("pose/error", 1000, true);  // see pose/estimate
     // The evaluator is outside the lockstep loop: at 10x real time and more, a queue of 10 (1 s of sim time)
@@ -54,17 +62,33 @@ class PoseEvaluator {
     while (static_cast<int>(map->size()) > buffer_size_) map->erase(map->begin());
   }
 
+  // A message stamped more than restart_time_jump_s before the last stamp evaluated: time went back.
+  void startAgainIfTimeWentBack(const ros::Time& stamp) {
+    if (!have_evaluated_ || stamp.toSec() >= last_evaluated_.toSec() - restart_time_jump_s_) return;
+    ROS_WARN(
+        "pose_evaluator: t = %.6f is %.3f s before the last stamp evaluated: time went back, buffers emptied "
+        "(%zu estimates, %zu target and %zu chaser states waiting)",
+        stamp.toSec(), (last_evaluated_ - stamp).toSec(), estimates_.size(), target_.size(), chaser_.size());
+    estimates_.clear();
+    target_.clear();
+    chaser_.clear();
+    have_evaluated_ = false;
+  }
+
   void onTarget(const nav_msgs::OdometryConstPtr& msg) {
+    startAgainIfTimeWentBack(msg->header.stamp);
     target_[msg->header.stamp] = msg;
     bound(&target_);
     evaluate(msg->header.stamp);
   }
   void onChaser(const nav_msgs::OdometryConstPtr& msg) {
+    startAgainIfTimeWentBack(msg->header.stamp);
     chaser_[msg->header.stamp] = msg;
     bound(&chaser_);
     evaluate(msg->header.stamp);
   }
   void onEstimate(const ardsim_msgs::PoseEstimateConstPtr& msg) {
+    startAgainIfTimeWentBack(msg->header.stamp);
     estimates_[msg->header.stamp] = msg;
     bound(&estimates_);
     evaluate(msg->header.stamp);
@@ -86,6 +110,8 @@ class PoseEvaluator {
           ardsim_description::lidarFromTarget(T_eci_target, T_eci_chaser, T_chaser_lidar_);
       error_publisher_.publish(toPoseError(poseError(T_estimate, truth, T_target_port_), *estimate->second));
     }
+    last_evaluated_ = stamp;
+    have_evaluated_ = true;
     // This stamp is done; older ones will not be completed either.
     estimates_.erase(estimates_.begin(), std::next(estimate));
     target_.erase(target_.begin(), std::next(target));
@@ -93,6 +119,9 @@ class PoseEvaluator {
   }
 
   int buffer_size_ = 100;
+  double restart_time_jump_s_ = 1.0;
+  bool have_evaluated_ = false;
+  ros::Time last_evaluated_;
   Eigen::Isometry3d T_target_port_;
   Eigen::Isometry3d T_chaser_lidar_;
   std::map<ros::Time, nav_msgs::OdometryConstPtr> target_;

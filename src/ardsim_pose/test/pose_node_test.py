@@ -2,7 +2,7 @@
 """Interface test of the pose node/nodelet: drives the lidar with truth steps (the chaser on the ISS docking axis,
 its port 29 m out) and publishes bad clouds of its own (NaN-filled, empty, unorganized, truncated, without a z
 field, in another frame), skips a frame, then steps time back; every cloud must be answered by exactly one pose/estimate with
-its stamp, and every estimate by one pose/error."""
+its stamp, and every estimate with its truth by one pose/error, after time went back too."""
 import math
 import struct
 import subprocess
@@ -145,10 +145,21 @@ class PoseInterfaceTest(unittest.TestCase):
         self.wait_for(lambda: any('1 frame(s) missing before t = 7.000000' in m.msg for m in self.logs),
                       'the missing frame logged')
 
-        # Time back 6 s (a bag played again): logged, the estimator starts again from the initial estimate.
+        # Frames with no truth: their estimates wait in the evaluator (buffer_size 3) for a truth that never comes.
+        for seconds in (8.0, 9.0, 10.0):
+            self.answer(seconds, lambda s: self.points.publish(cloud(s, 256, 256, float('nan'))))
+
+        # Time back 9 s (a bag played again): logged, the estimator starts again from the initial estimate, and the
+        # evaluator empties its buffers, whose three waiting estimates would otherwise, being newer, push out the new
+        # one (a bounded buffer drops its oldest) and leave t = 1 without an error.
         estimate = self.answer(1.0, self.truth_step)
         self.assertNotEqual(estimate.status, PoseEstimate.STATUS_LOST, estimate.reason)
-        self.wait_for(lambda: any('time went back' in m.msg for m in self.logs), 'the time jump logged')
+        self.wait_for(lambda: any('time went back, started again' in m.msg for m in self.logs),
+                      'the time jump logged by the pose node')
+        self.wait_for(lambda: any(e.header.stamp == rospy.Time.from_sec(1.0) for e in self.errors[3:]),
+                      'the pose error at t = 1 after time went back')
+        self.wait_for(lambda: any('time went back, buffers emptied (3 estimates' in m.msg for m in self.logs),
+                      'the time jump logged by the evaluator')
 
     def test_bad_parameter_stops_the_node_with_a_clear_error(self):
         # One node name per case: a _param:= setting stays on the parameter server after its node exits.
@@ -174,8 +185,11 @@ class PoseInterfaceTest(unittest.TestCase):
                  ('_panels/window:=4', 'panels/window = 4'),
                  ('_panels/first_window:=2', 'panels/first_window = 2'),
                  ('_panels/enabled:=true', 'panels/enabled is not allowed for target iss')]
-        for case, (setting, named) in enumerate(cases):
-            result = subprocess.run(['rosrun', 'ardsim_pose', 'pose_node', '__name:=bad_pose_%d' % case, setting],
+        runs = [('pose_node', 'bad_pose_%d' % case, setting, named) for case, (setting, named) in enumerate(cases)]
+        runs += [('pose_evaluator', 'bad_evaluator_0', '_restart_time_jump_s:=-1.0', 'restart_time_jump_s = -1'),
+                 ('pose_evaluator', 'bad_evaluator_1', '_buffer_size:=0', 'buffer_size = 0')]
+        for node_type, name, setting, named in runs:
+            result = subprocess.run(['rosrun', 'ardsim_pose', node_type, '__name:=' + name, setting],
                                     capture_output=True, text=True, timeout=120)
             self.assertNotEqual(result.returncode, 0, setting)
             self.assertIn(named, result.stdout + result.stderr, setting)
