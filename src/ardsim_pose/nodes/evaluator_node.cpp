@@ -21,7 +21,7 @@ class PoseEvaluator {
       StampMatcher<ardsim_msgs::PoseEstimateConstPtr, nav_msgs::OdometryConstPtr, nav_msgs::OdometryConstPtr>;
 
  public:
-  PoseEvaluator(ros::NodeHandle nh, const ros::NodeHandle& private_nh) {
+  PoseEvaluator(ros::NodeHandle nh, const ros::NodeHandle& private_nh) : matcher_(makeMatcher(private_nh)) {
     std::string target = "iss";
     private_nh.param("target", target, target);
     try {
@@ -29,17 +29,6 @@ class PoseEvaluator {
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(std::string("parameter target: ") + e.what());
     }
-    int buffer_size = 100;
-    private_nh.param("buffer_size", buffer_size, buffer_size);
-    if (buffer_size < 1 || buffer_size > 10000)
-      throw std::invalid_argument("parameter buffer_size = " + std::to_string(buffer_size) +
-                                  " is out of range: 1 .. 10000");
-    double restart_time_jump_s = 1.0;
-    private_nh.param("restart_time_jump_s", restart_time_jump_s, restart_time_jump_s);
-    if (!(std::isfinite(restart_time_jump_s) && restart_time_jump_s >= 0.0 && restart_time_jump_s <= 1e6))
-      throw std::invalid_argument("parameter restart_time_jump_s = " + std::to_string(restart_time_jump_s) +
-                                  " is out of range: 0 .. 1e6");
-    matcher_ = Matcher(buffer_size, static_cast<Matcher::Stamp>(std::llround(restart_time_jump_s * 1e9)));
     T_chaser_lidar_ = ardsim_description::T_chaser_lidar();
     error_publisher_ = nh.advertise<ardsim_msgs::PoseError>("pose/error", 1000, true);  // see pose/estimate
     // The evaluator is outside the lockstep loop: at 10x real time and more, a queue of 10 (1 s of sim time)
@@ -62,6 +51,20 @@ class PoseEvaluator {
   }
 
  private:
+  static Matcher makeMatcher(const ros::NodeHandle& private_nh) {
+    int buffer_size = 100;
+    private_nh.param("buffer_size", buffer_size, buffer_size);
+    if (buffer_size < 1 || buffer_size > 10000)
+      throw std::invalid_argument("parameter buffer_size = " + std::to_string(buffer_size) +
+                                  " is out of range: 1 .. 10000");
+    double restart_time_jump_s = 1.0;
+    private_nh.param("restart_time_jump_s", restart_time_jump_s, restart_time_jump_s);
+    if (!(std::isfinite(restart_time_jump_s) && restart_time_jump_s >= 0.0 && restart_time_jump_s <= 1e6))
+      throw std::invalid_argument("parameter restart_time_jump_s = " + std::to_string(restart_time_jump_s) +
+                                  " is out of range: 0 .. 1e6");
+    return Matcher(buffer_size, static_cast<Matcher::Stamp>(std::llround(restart_time_jump_s * 1e9)));
+  }
+
   // A new time line (time went back) is logged; a completed stamp is evaluated.
   void handle(const Matcher::Added& added, const ros::Time& stamp) {
     if (added.went_back_from)
@@ -101,7 +104,7 @@ class PoseEvaluator {
 
   Eigen::Isometry3d T_target_port_;
   Eigen::Isometry3d T_chaser_lidar_;
-  Matcher matcher_{1, 0};
+  Matcher matcher_;
   ros::Publisher error_publisher_;
   ros::Subscriber estimate_subscriber_, target_subscriber_, chaser_subscriber_;
   ros::WallTimer connect_timer_;

@@ -25,8 +25,8 @@ class StampMatcher {
 
   struct Added {
     std::optional<Match> match;  // every stream's message of this stamp, now all in
-    std::optional<Stamp>
-        went_back_from;  // this message started a new time line: the last stamp matched before
+    // Set where this message started a new time line: the last stamp matched before it.
+    std::optional<Stamp> went_back_from;
   };
 
   StampMatcher(std::size_t buffer_size, Stamp restart_time_jump)
