@@ -4,6 +4,7 @@
 // which also keeps time lines apart when time goes back). Evaluation only.
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 
 #include <ardsim_msgs/log_throttle.h>
@@ -11,6 +12,7 @@
 #include <ros/ros.h>
 
 #include "ardsim_description/frames.h"
+#include "ardsim_pose/require_option.h"
 #include "ardsim_pose/stamp_matcher.h"
 #include "conversions.h"
 
@@ -54,14 +56,12 @@ class PoseEvaluator {
   static Matcher makeMatcher(const ros::NodeHandle& private_nh) {
     int buffer_size = 100;
     private_nh.param("buffer_size", buffer_size, buffer_size);
-    if (buffer_size < 1 || buffer_size > 10000)
-      throw std::invalid_argument("parameter buffer_size = " + std::to_string(buffer_size) +
-                                  " is out of range: 1 .. 10000");
+    requireParameter(buffer_size >= 1 && buffer_size <= 10000, "buffer_size", buffer_size, "1 .. 10000");
     double restart_time_jump_s = 1.0;
     private_nh.param("restart_time_jump_s", restart_time_jump_s, restart_time_jump_s);
-    if (!(std::isfinite(restart_time_jump_s) && restart_time_jump_s >= 0.0 && restart_time_jump_s <= 1e6))
-      throw std::invalid_argument("parameter restart_time_jump_s = " + std::to_string(restart_time_jump_s) +
-                                  " is out of range: 0 .. 1e6");
+    requireParameter(
+        std::isfinite(restart_time_jump_s) && restart_time_jump_s >= 0.0 && restart_time_jump_s <= 1e6,
+        "restart_time_jump_s", restart_time_jump_s, "0 .. 1e6");
     return Matcher(buffer_size, static_cast<Matcher::Stamp>(std::llround(restart_time_jump_s * 1e9)));
   }
 

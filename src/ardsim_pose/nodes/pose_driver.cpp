@@ -9,6 +9,7 @@
 #include <ardsim_msgs/param_read.h>
 
 #include "ardsim_dynamics/scenario.h"
+#include "ardsim_pose/require_option.h"
 #include "conversions.h"
 
 namespace ardsim_pose {
@@ -55,9 +56,8 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "child_frame_id", &o.child_frame_id);
   read(nh, "publish_tf", &o.publish_tf);
   read(nh, "cloud_queue_size", &o.cloud_queue_size);
-  if (o.cloud_queue_size < 1 || o.cloud_queue_size > 1000)
-    throw std::invalid_argument("parameter cloud_queue_size = " + std::to_string(o.cloud_queue_size) +
-                                " is out of range: 1 .. 1000");
+  requireParameter(o.cloud_queue_size >= 1 && o.cloud_queue_size <= 1000, "cloud_queue_size",
+                   o.cloud_queue_size, "1 .. 1000");
 
   read(nh, "model/spacing_at_port_m", &c.model.spacing_at_port_m);
   read(nh, "model/spacing_growth_per_m", &c.model.spacing_growth_per_m);
@@ -163,9 +163,8 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
     throw std::invalid_argument("parameter initial/source = '" + o.initial_source +
                                 "' is not allowed: docking_axis, parameters or scenario");
   read(nh, "initial/port_distance_m", &o.initial_port_distance_m);
-  if (!(std::isfinite(o.initial_port_distance_m) && o.initial_port_distance_m > 0.0))
-    throw std::invalid_argument("parameter initial/port_distance_m = " +
-                                std::to_string(o.initial_port_distance_m) + " is out of range: > 0");
+  requireParameter(std::isfinite(o.initial_port_distance_m) && o.initial_port_distance_m > 0.0,
+                   "initial/port_distance_m", o.initial_port_distance_m, "> 0");
   readVector(nh, "initial/position_m", &o.initial_position_m);
   readVector(nh, "initial/rpy_deg", &o.initial_rpy_deg);
   read(nh, "initial/scenario_file", &o.initial_scenario_file);
@@ -176,21 +175,15 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   read(nh, "initial/attitude_deg", &o.perturbation.attitude_deg);
   read(nh, "initial/range_fraction", &o.perturbation.range_fraction);
   read(nh, "initial/lateral_m", &o.perturbation.lateral_m);
-  if (!(std::isfinite(o.perturbation.attitude_deg) && o.perturbation.attitude_deg >= 0.0 &&
-        o.perturbation.attitude_deg <= 180.0))
-    throw std::invalid_argument("parameter initial/attitude_deg = " +
-                                std::to_string(o.perturbation.attitude_deg) + " is out of range: 0 .. 180");
-  if (!(std::isfinite(o.perturbation.range_fraction) && o.perturbation.range_fraction >= 0.0 &&
-        o.perturbation.range_fraction < 1.0))
-    throw std::invalid_argument("parameter initial/range_fraction = " +
-                                std::to_string(o.perturbation.range_fraction) + " is out of range: 0 .. < 1");
-  if (!(std::isfinite(o.perturbation.lateral_m) && o.perturbation.lateral_m >= 0.0))
-    throw std::invalid_argument("parameter initial/lateral_m = " + std::to_string(o.perturbation.lateral_m) +
-                                " is out of range: >= 0");
+  const PriorPerturbation& p = o.perturbation;
+  requireParameter(std::isfinite(p.attitude_deg) && p.attitude_deg >= 0.0 && p.attitude_deg <= 180.0,
+                   "initial/attitude_deg", p.attitude_deg, "0 .. 180");
+  requireParameter(std::isfinite(p.range_fraction) && p.range_fraction >= 0.0 && p.range_fraction < 1.0,
+                   "initial/range_fraction", p.range_fraction, "0 .. < 1");
+  requireParameter(std::isfinite(p.lateral_m) && p.lateral_m >= 0.0, "initial/lateral_m", p.lateral_m,
+                   ">= 0");
   read(nh, "initial/seed", &o.initial_seed);
-  if (o.initial_seed < 0)
-    throw std::invalid_argument("parameter initial/seed = " + std::to_string(o.initial_seed) +
-                                " is out of range: >= 0");
+  requireParameter(o.initial_seed >= 0, "initial/seed", o.initial_seed, ">= 0");
   return o;
 }
 

@@ -5,6 +5,7 @@
 
 #include "ardsim_description/mesh_tools.h"
 #include "ardsim_description/models.h"
+#include "ardsim_pose/require_option.h"
 
 namespace ardsim_pose {
 
@@ -14,9 +15,9 @@ void validate(const PoseConfig& c) {
   close_range::validate(c.mode);
   // The pyramid's cells, sized for the ring at 12 m and nearer, gave Hubble poses 7 cm off from 15.5 m (gtest
   // CloseRangeHubble): a clear error, not a wrong pose.
-  if (c.mode.close_method == EstimateMethod::kPyramid && c.mode.close_enter_range_m > 12.0)
-    throw std::invalid_argument("mode/close_enter_range_m = " + std::to_string(c.mode.close_enter_range_m) +
-                                " is out of range with mode/close_method pyramid: <= 12");
+  requireOption(c.mode.close_method != EstimateMethod::kPyramid || c.mode.close_enter_range_m <= 12.0,
+                "mode/close_enter_range_m", c.mode.close_enter_range_m,
+                "<= 12 with mode/close_method pyramid");
   ardsim_lidar::validate(c.sensor);
   validate(c.model);
   validate(c.visibility);

@@ -11,7 +11,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
-#include "require_option.h"
+#include "ardsim_pose/require_option.h"
 #include "tukey_weight.h"
 
 namespace ardsim_pose {

@@ -7,7 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "require_option.h"
+#include "ardsim_pose/require_option.h"
 
 namespace ardsim_pose {
 

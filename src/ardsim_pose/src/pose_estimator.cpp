@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "require_option.h"
+#include "ardsim_pose/require_option.h"
 
 namespace ardsim_pose {
 

@@ -14,7 +14,7 @@
 
 #include <nanoflann.hpp>
 
-#include "require_option.h"
+#include "ardsim_pose/require_option.h"
 
 namespace ardsim_pose {
 

@@ -15,6 +15,7 @@
 #include "ardsim_pose/estimator_factory.h"
 #include "ardsim_pose/evaluation.h"
 #include "ardsim_pose/pose_estimator.h"
+#include "ardsim_pose/require_option.h"
 #include "expect_refused.h"
 
 namespace ardsim_pose {
@@ -384,6 +385,21 @@ TEST(PoseConfigTargets, PyramidBeyondTwelveMetresIsRefused) {
   applyTargetDefaults(&iss);
   iss.mode.close_method = EstimateMethod::kPyramid;
   EXPECT_NO_THROW(validate(iss));
+}
+
+// A refusal gives the value as it is written ("3", not "3.000000") and what is allowed, the core's options
+// and the close-range mode's alike.
+TEST(PoseConfigOptions, RefusalGivesTheValueAsWrittenAndWhatIsAllowed) {
+  PoseConfig config;
+  applyTargetDefaults(&config);
+  config.icp.max_points = 3;
+  expectRefused(config, "icp/max_points = 3 is out of range: 50 .. 100000");
+  applyTargetDefaults(&(config = PoseConfig()));
+  config.mode.close_enter_fill = 1.25;
+  expectRefused(config, "mode/close_enter_fill = 1.25 is out of range: 0 .. 1");
+  EXPECT_EQ(optionValueText(-0.001), "-0.001");
+  EXPECT_EQ(optionValueText(0.1), "0.1");
+  EXPECT_EQ(optionValueText(1e6), "1000000");
 }
 
 // The composite pose: a target whose port lies 6 m from its origin, 20 m out; "ICP" with its port 2 cm off

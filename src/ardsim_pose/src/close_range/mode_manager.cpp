@@ -1,30 +1,22 @@
 #include "ardsim_pose/close_range/mode_manager.h"
 
 #include <cmath>
-#include <stdexcept>
-#include <string>
+
+#include "ardsim_pose/require_option.h"
 
 namespace ardsim_pose {
 namespace close_range {
 
-namespace {
-
-void require(bool ok, const std::string& name, double value, const std::string& allowed) {
-  if (!ok) throw std::invalid_argument(name + " = " + std::to_string(value) + ": allowed " + allowed);
-}
-
-}  // namespace
-
 void validate(const ModeManagerOptions& o) {
-  require(o.close_enter_range_m > 0.0, "mode/close_enter_range_m", o.close_enter_range_m, "> 0");
-  require(o.close_exit_range_m > o.close_enter_range_m, "mode/close_exit_range_m", o.close_exit_range_m,
-          "> mode/close_enter_range_m (hysteresis)");
-  require(o.close_enter_fill >= 0.0 && o.close_enter_fill <= 1.0, "mode/close_enter_fill", o.close_enter_fill,
-          "0..1");
-  require(o.lost_frames_to_exit >= 1, "mode/lost_frames_to_exit", o.lost_frames_to_exit, ">= 1");
-  require(o.blend_frames >= 1, "mode/blend_frames", o.blend_frames, ">= 1");
-  require(o.close_method == EstimateMethod::kRing || o.close_method == EstimateMethod::kPyramid,
-          "mode/close_method", static_cast<int>(o.close_method), "ring or pyramid");
+  requireOption(o.close_enter_range_m > 0.0, "mode/close_enter_range_m", o.close_enter_range_m, "> 0");
+  requireOption(o.close_exit_range_m > o.close_enter_range_m, "mode/close_exit_range_m", o.close_exit_range_m,
+                "> mode/close_enter_range_m (hysteresis)");
+  requireOption(o.close_enter_fill >= 0.0 && o.close_enter_fill <= 1.0, "mode/close_enter_fill",
+                o.close_enter_fill, "0 .. 1");
+  requireOption(o.lost_frames_to_exit >= 1, "mode/lost_frames_to_exit", o.lost_frames_to_exit, ">= 1");
+  requireOption(o.blend_frames >= 1, "mode/blend_frames", o.blend_frames, ">= 1");
+  requireOption(o.close_method == EstimateMethod::kRing || o.close_method == EstimateMethod::kPyramid,
+                "mode/close_method", static_cast<int>(o.close_method), "ring or pyramid");
 }
 
 double viewFill(const OrganizedCloud& cloud) {
