@@ -29,13 +29,16 @@ void readVector(const ros::NodeHandle& nh, const std::string& name, Eigen::Vecto
   *value = Eigen::Vector3d(v[0], v[1], v[2]);
 }
 
-// Prefixes the core's "name = value is out of range" with the parameter namespace.
+// Prefixes the core's "name = value is out of range" with the parameter namespace. The lidar core's sensor
+// check (width, height, fov_deg) names its parameter itself, so its message is kept as it is.
 template <typename F>
 void validated(const std::string& what, F check) {
   try {
     check();
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("parameter " + what + e.what());
+    const std::string message = e.what();
+    if (message.rfind("parameter ", 0) == 0) throw;
+    throw std::invalid_argument("parameter " + what + message);
   }
 }
 

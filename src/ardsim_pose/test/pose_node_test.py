@@ -184,7 +184,8 @@ class PoseInterfaceTest(unittest.TestCase):
                  ('_icp/lateral_vote_weight:=-3.0', 'icp/lateral_vote_weight = -3'),
                  ('_panels/window:=4', 'panels/window = 4'),
                  ('_panels/first_window:=2', 'panels/first_window = 2'),
-                 ('_panels/enabled:=true', 'panels/enabled is not allowed for target iss')]
+                 ('_panels/enabled:=true', 'panels/enabled is not allowed for target iss'),
+                 ('_width:=0', 'parameter width = 0')]
         runs = [('pose_node', 'bad_pose_%d' % case, setting, named) for case, (setting, named) in enumerate(cases)]
         runs += [('pose_evaluator', 'bad_evaluator_0', '_restart_time_jump_s:=-1.0', 'restart_time_jump_s = -1'),
                  ('pose_evaluator', 'bad_evaluator_1', '_buffer_size:=0', 'buffer_size = 0')]
@@ -193,6 +194,7 @@ class PoseInterfaceTest(unittest.TestCase):
                                     capture_output=True, text=True, timeout=120)
             self.assertNotEqual(result.returncode, 0, setting)
             self.assertIn(named, result.stdout + result.stderr, setting)
+            self.assertNotIn('parameter parameter', result.stdout + result.stderr, setting)
 
 
 if __name__ == '__main__':
