@@ -40,18 +40,15 @@ LidarNodeOptions loadOptions(const ros::NodeHandle& nh) {
   LidarNodeOptions o;
   std::string target = ardsim_description::targetKindName(o.target);
   read(nh, "target", &target);
-  try {
-    o.target = ardsim_description::parseTargetKind(target);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string("parameter target: ") + e.what());
-  }
+  ardsim_msgs::validateParameters([&] { o.target = ardsim_description::parseTargetKind(target); },
+                                  "target: ");
   read(nh, "width", &o.sensor.width);
   read(nh, "height", &o.sensor.height);
   readFloat(nh, "fov_deg", &o.sensor.fov_deg);
   readFloat(nh, "min_range_m", &o.sensor.min_range_m);
   readFloat(nh, "max_range_m", &o.sensor.max_range_m);
   readFloat(nh, "near_plane_m", &o.sensor.near_plane_m);
-  validate(o.sensor);
+  ardsim_msgs::validateParameters([&] { validate(o.sensor); });
 
   int seed = static_cast<int>(o.seed);
   read(nh, "seed", &seed);
@@ -64,7 +61,7 @@ LidarNodeOptions loadOptions(const ros::NodeHandle& nh) {
                                 " is out of range: >= 0 (0 = every truth step)");
   read(nh, "faults/drop_intervals_s", &o.faults.drop_intervals_s);
   read(nh, "faults/blind_intervals_s", &o.faults.blind_intervals_s);
-  validate(o.faults);
+  ardsim_msgs::validateParameters([&] { validate(o.faults); });
   read(nh, "frame_id", &o.frame_id);
   std::string platform = "auto";
   read(nh, "egl_platform", &platform);
@@ -102,7 +99,7 @@ LidarNodeOptions loadOptions(const ros::NodeHandle& nh) {
   readFloat(nh, "noise/bloom_probability", &n.bloom_probability);
   read(nh, "noise/saturation", &n.saturation);
   readFloat(nh, "noise/saturation_range_bias_m", &n.saturation_range_bias_m);
-  validate(n);
+  ardsim_msgs::validateParameters([&] { validate(n); });
 
   readFloat(nh, "iss/sarj_port_deg", &o.iss.sarj_port_deg);
   readFloat(nh, "iss/sarj_starboard_deg", &o.iss.sarj_starboard_deg);

@@ -547,9 +547,8 @@ struct EglRenderer::Impl {
 EglRenderer::EglRenderer(const SensorOptions& sensor, const RendererOptions& options)
     : impl_(new Impl((validate(sensor), sensor))) {
   if (options.triangles_per_chunk < 1)
-    throw std::invalid_argument(
-        "parameter triangles_per_chunk = " + std::to_string(options.triangles_per_chunk) +
-        " is out of range: allowed >= 1");
+    throw std::invalid_argument("triangles_per_chunk = " + std::to_string(options.triangles_per_chunk) +
+                                " is out of range: allowed >= 1");
   impl_->options = options;
   impl_->openDisplay();
   impl_->createContext();

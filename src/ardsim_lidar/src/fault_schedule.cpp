@@ -16,11 +16,11 @@ void validateIntervals(const std::vector<double>& times_s, const std::string& na
   for (double t : times_s) text << (text.tellp() > 0 ? " " : "") << t;
   const std::string value = "[" + text.str() + "]";
   if (times_s.size() % 2 != 0)
-    throw std::invalid_argument("parameter " + name + " = " + value +
+    throw std::invalid_argument(name + " = " + value +
                                 " is out of range: allowed a flat list of pairs [t0, t1, ...] (s)");
   for (std::size_t i = 0; i < times_s.size(); i += 2)
     if (!std::isfinite(times_s[i]) || !std::isfinite(times_s[i + 1]) || times_s[i + 1] < times_s[i])
-      throw std::invalid_argument("parameter " + name + " = " + value +
+      throw std::invalid_argument(name + " = " + value +
                                   " is out of range: each pair needs finite times with t0 <= t1 (s)");
 }
 

@@ -24,7 +24,7 @@ constexpr float kNoReturn = std::numeric_limits<float>::quiet_NaN();
 void require(bool ok, const std::string& name, double value, const std::string& allowed) {
   if (ok) return;
   std::ostringstream message;
-  message << "parameter noise/" << name << " = " << value << " is out of range: allowed " << allowed;
+  message << "noise/" << name << " = " << value << " is out of range: allowed " << allowed;
   throw std::invalid_argument(message.str());
 }
 

@@ -11,7 +11,7 @@ namespace {
 void require(bool ok, const std::string& name, double value, const std::string& allowed) {
   if (ok) return;
   std::ostringstream message;
-  message << "parameter " << name << " = " << value << " is out of range: allowed " << allowed;
+  message << name << " = " << value << " is out of range: allowed " << allowed;
   throw std::invalid_argument(message.str());
 }
 

@@ -4,10 +4,10 @@
 // which also keeps time lines apart when time goes back). Evaluation only.
 #include <cmath>
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 
 #include <ardsim_msgs/log_throttle.h>
+#include <ardsim_msgs/param_read.h>
 #include <ardsim_msgs/startup_error.h>
 #include <ros/ros.h>
 
@@ -26,11 +26,11 @@ class PoseEvaluator {
   PoseEvaluator(ros::NodeHandle nh, const ros::NodeHandle& private_nh) : matcher_(makeMatcher(private_nh)) {
     std::string target = "iss";
     private_nh.param("target", target, target);
-    try {
-      T_target_port_ = ardsim_description::T_target_port(ardsim_description::parseTargetKind(target));
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("parameter target: ") + e.what());
-    }
+    ardsim_msgs::validateParameters(
+        [&] {
+          T_target_port_ = ardsim_description::T_target_port(ardsim_description::parseTargetKind(target));
+        },
+        "target: ");
     T_chaser_lidar_ = ardsim_description::T_chaser_lidar();
     error_publisher_ = nh.advertise<ardsim_msgs::PoseError>("pose/error", 1000, true);  // see pose/estimate
     // The evaluator is outside the lockstep loop: at 10x real time and more, a queue of 10 (1 s of sim time)

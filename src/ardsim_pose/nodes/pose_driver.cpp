@@ -29,19 +29,6 @@ void readVector(const ros::NodeHandle& nh, const std::string& name, Eigen::Vecto
   *value = Eigen::Vector3d(v[0], v[1], v[2]);
 }
 
-// Prefixes the core's "name = value is out of range" with the parameter namespace. The lidar core's sensor
-// check (width, height, fov_deg) names its parameter itself, so its message is kept as it is.
-template <typename F>
-void validated(const std::string& what, F check) {
-  try {
-    check();
-  } catch (const std::invalid_argument& e) {
-    const std::string message = e.what();
-    if (message.rfind("parameter ", 0) == 0) throw;
-    throw std::invalid_argument("parameter " + what + message);
-  }
-}
-
 }  // namespace
 
 PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
@@ -49,7 +36,8 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
   PoseConfig& c = o.config;
   std::string target = ardsim_description::targetKindName(c.target);
   read(nh, "target", &target);
-  validated("target: ", [&] { c.target = ardsim_description::parseTargetKind(target); });
+  ardsim_msgs::validateParameters([&] { c.target = ardsim_description::parseTargetKind(target); },
+                                  "target: ");
   applyTargetDefaults(&c);  // the parameters below override them
   read(nh, "method", &c.method);
   read(nh, "width", &c.sensor.width);
@@ -158,7 +146,7 @@ PoseNodeOptions loadOptions(const ros::NodeHandle& nh) {
                                 "' is not allowed: ring or pyramid");
   m.close_method = close_method == "pyramid" ? EstimateMethod::kPyramid : EstimateMethod::kRing;
   // The core names the option (e.g. "icp/max_points = 3 is out of range: ...").
-  validated("", [&] { validate(c); });
+  ardsim_msgs::validateParameters([&] { validate(c); });
 
   read(nh, "initial/source", &o.initial_source);
   if (o.initial_source != "docking_axis" && o.initial_source != "parameters" &&

@@ -18,4 +18,15 @@ void readParam(const ros::NodeHandle& nh, const std::string& name, T* value,
     throw std::invalid_argument("parameter " + name + " has the wrong type (see " + defaults_file + ")");
 }
 
+// Runs a core's option check and names what it refuses as a node parameter: a core says "name = value is out
+// of range: ...", the node "parameter <prefix>name = value ...".
+template <typename Check>
+void validateParameters(Check check, const std::string& prefix = "") {
+  try {
+    check();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("parameter " + prefix + e.what());
+  }
+}
+
 }  // namespace ardsim_msgs
