@@ -394,7 +394,8 @@ TEST(PoseConfigOptions, RefusalGivesTheValueAsWrittenAndWhatIsAllowed) {
   applyTargetDefaults(&config);
   config.icp.max_points = 3;
   expectRefused(config, "icp/max_points = 3 is out of range: 50 .. 100000");
-  applyTargetDefaults(&(config = PoseConfig()));
+  config = PoseConfig();
+  applyTargetDefaults(&config);
   config.mode.close_enter_fill = 1.25;
   expectRefused(config, "mode/close_enter_fill = 1.25 is out of range: 0 .. 1");
   EXPECT_EQ(optionValueText(-0.001), "-0.001");
