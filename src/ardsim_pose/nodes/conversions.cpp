@@ -81,8 +81,14 @@ bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, const std::string& sen
       *error = std::string("field ") + names[k] + " lies outside point_step";
       return false;
     }
-  if (msg.row_step < msg.width * msg.point_step ||
-      msg.data.size() < static_cast<std::size_t>(msg.row_step) * msg.height) {
+  // In 64 bits: a header's width x point_step can pass 2^32 and would wrap past the checks.
+  const std::uint64_t row_bytes = static_cast<std::uint64_t>(msg.width) * msg.point_step;
+  if (msg.row_step < row_bytes) {
+    *error = "row_step " + std::to_string(msg.row_step) + " is shorter than width x point_step (" +
+             std::to_string(row_bytes) + ")";
+    return false;
+  }
+  if (msg.data.size() < static_cast<std::uint64_t>(msg.row_step) * msg.height) {
     *error = "cloud data is shorter than its row_step x height";
     return false;
   }
@@ -90,7 +96,8 @@ bool fromPointCloud2(const sensor_msgs::PointCloud2& msg, const std::string& sen
   if (offsets[3] >= 0) cloud->intensity.resize(count);
   for (std::uint32_t v = 0; v < msg.height; ++v) {
     for (std::uint32_t u = 0; u < msg.width; ++u) {
-      const std::uint8_t* point = msg.data.data() + v * msg.row_step + u * msg.point_step;
+      const std::uint8_t* point = msg.data.data() + static_cast<std::size_t>(v) * msg.row_step +
+                                  static_cast<std::size_t>(u) * msg.point_step;
       const std::size_t i = static_cast<std::size_t>(v) * msg.width + u;
       float xyz[3];
       for (int k = 0; k < 3; ++k) std::memcpy(&xyz[k], point + offsets[k], sizeof(float));

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Interface test of the pose node/nodelet: drives the lidar with truth steps (the chaser on the ISS docking axis,
 its port 29 m out) and publishes bad clouds of its own (NaN-filled, empty, unorganized, truncated, without a z
-field, in another frame), skips a frame, then steps time back; every cloud must be answered by exactly one pose/estimate with
-its stamp, and every estimate with its truth by one pose/error, after time went back too."""
+field, in another frame, one whose header's size passes 2^32), skips a frame, then steps time back; every cloud
+must be answered by exactly one pose/estimate with its stamp, and every estimate with its truth by one pose/error,
+after time went back too."""
 import math
 import struct
 import subprocess
@@ -99,6 +100,12 @@ class PoseInterfaceTest(unittest.TestCase):
         return msg
 
     @staticmethod
+    def overflowing(msg):
+        # width x point_step = 2^32 with no data: wrapped to 32 bits it passed the size checks (the node crashed).
+        msg.width, msg.height, msg.point_step, msg.row_step = 65536, 2, 65536, 0
+        return msg
+
+    @staticmethod
     def in_chaser_frame(msg):
         msg.header.frame_id = 'chaser'
         return msg
@@ -131,6 +138,9 @@ class PoseInterfaceTest(unittest.TestCase):
         truncated = self.answer(6.5, lambda s: self.points.publish(self.truncated(cloud(s, 256, 256, 1.0))))
         self.assertEqual(truncated.status, PoseEstimate.STATUS_LOST)
         self.assertIn('shorter', truncated.reason)
+        overflowing = self.answer(6.6, lambda s: self.points.publish(self.overflowing(cloud(s, 0, 0, 0.0))))
+        self.assertEqual(overflowing.status, PoseEstimate.STATUS_LOST)
+        self.assertIn('row_step 0 is shorter than width x point_step', overflowing.reason)
         no_z = self.answer(6.7, lambda s: self.points.publish(self.renamed_z(cloud(s, 256, 256, 1.0))))
         self.assertEqual(no_z.status, PoseEstimate.STATUS_LOST)
         self.assertIn('no field z', no_z.reason)

@@ -73,6 +73,30 @@ TEST(PoseConversions, RejectsMalformedClouds) {
   EXPECT_TRUE(cloud.points.empty());
 }
 
+// A header whose width x point_step passes 2^32 (here exactly: 65536 x 65536) with no data: in 32-bit
+// arithmetic that size wraps to 0, the checks against row_step and the data pass, and the conversion reads
+// far beyond the message (a crash). Refused instead, and nothing read.
+TEST(PoseConversions, RejectsACloudWhoseSizeOverflows32Bits) {
+  sensor_msgs::PointCloud2 msg = makeCloud(0, 0, 1.0f);
+  msg.width = 65536;
+  msg.height = 2;
+  msg.point_step = 65536;
+  msg.row_step = 0;
+  msg.data.clear();
+  OrganizedCloud cloud;
+  std::string error;
+  EXPECT_FALSE(fromPointCloud2(msg, kSensorFrame, &cloud, &error));
+  EXPECT_NE(error.find("row_step 0 is shorter than width x point_step (4294967296)"), std::string::npos)
+      << error;
+  EXPECT_TRUE(cloud.points.empty());
+  // The same where the wrapped size is not 0 (65537 x 65536 = 2^32 + 65536) and the data hold that much.
+  msg.width = 65537;
+  msg.row_step = 65536;
+  msg.data.assign(2 * 65536, 0);
+  EXPECT_FALSE(fromPointCloud2(msg, kSensorFrame, &cloud, &error));
+  EXPECT_TRUE(cloud.points.empty());
+}
+
 TEST(PoseConversions, EstimateCarriesPoseStatusAndCovariance) {
   EstimatorOutput out;
   out.result.status = EstimateStatus::kDegraded;
