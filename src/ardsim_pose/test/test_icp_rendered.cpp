@@ -4,6 +4,7 @@
 // frame, a garbage frame and a frame of another object; the benchmark's 0.2 m-off guesses at 30 m corrected
 // along a weakly observed direction, with and without the sparse start; an acquisition whose iterations
 // cycle between two poses converging; a bag played again (time going back) estimated as the first time.
+// Hubble's rendered cases are in test_icp_rendered_hubble.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
